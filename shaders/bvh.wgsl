@@ -1,0 +1,283 @@
+// bvh.wgsl — BVH2 traversal (closest hit, any hit), ray–triangle/sphere/quad intersection and ray-origin offsetting.
+// Needs common.wgsl and geometry_bindings.wgsl. Every loop has an explicit bound: lavapipe has no watchdog.
+
+/// A BVH2 node holding both children's boxes (mirrors `GpuBvhNode` in src/bvh.rs, same field names). Per child:
+/// count > 0: leaf over prim_refs[first .. first + count]; count == 0 && first != INVALID: interior node
+/// bvh_nodes[first]; count == 0 && first == INVALID: no child (single-leaf and empty trees), skipped by the flag.
+struct BvhNode {
+    lmin: vec3<f32>,
+    l_first: u32,
+    lmax: vec3<f32>,
+    l_count: u32,
+    rmin: vec3<f32>,
+    r_first: u32,
+    rmax: vec3<f32>,
+    r_count: u32,
+}
+
+/// Traversal stack entries; src/bvh.rs (BVH_STACK_SIZE) guarantees tree depth ≤ this, so pushes never overflow.
+const BVH_STACK_SIZE: u32 = 64u;
+/// Upper bound on one leaf's loop (the builder makes ≤ 4); guards against a corrupt count.
+const BVH_MAX_LEAF_PRIMS: u32 = 255u;
+/// Conservative far-distance scale for the slab test, 1 + 2γ₃ rounded up (Ize 2013, "Robust BVH Ray Traversal",
+/// JCGT 2(2)): the rounded slab distances then never reject a box the exact ray passes through.
+const BVH_SLAB_FAR_SCALE: f32 = 1.0000004;
+/// Direction components smaller than this are replaced by ±this before inverting, so 1/d is finite and the slab
+/// products (b − o)·(1/d) are never 0·∞ = NaN.
+const BVH_TINY_DIR: f32 = 1e-30;
+
+/// Per-ray constants: origin, direction, safe inverse direction, and the shear/permutation of the watertight
+/// triangle test (Woop, Benthin, Wald 2013, "Watertight Ray/Triangle Intersection", JCGT 2(1), §3).
+struct TraceRay {
+    o: vec3<f32>,
+    d: vec3<f32>,
+    inv_d: vec3<f32>,
+    kx: u32,
+    ky: u32,
+    kz: u32,
+    shear: vec3<f32>, // (Sx, Sy, Sz)
+}
+
+fn trace_ray_setup(o: vec3<f32>, d: vec3<f32>) -> TraceRay {
+    let sgn = select(vec3<f32>(1.0), vec3<f32>(-1.0), d < vec3<f32>(0.0));
+    let d_safe = select(d, sgn * BVH_TINY_DIR, abs(d) < vec3<f32>(BVH_TINY_DIR));
+    // kz: the dominant axis of d; swap kx, ky when d[kz] < 0 to keep the winding (paper, Fig. 2).
+    let ad = abs(d);
+    var kz = 2u;
+    if ad.x >= ad.y && ad.x >= ad.z { kz = 0u; } else if ad.y >= ad.z { kz = 1u; }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kx + 1u) % 3u;
+    if d[kz] < 0.0 { let tmp = kx; kx = ky; ky = tmp; }
+    let shear = vec3<f32>(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+    return TraceRay(o, d, 1.0 / d_safe, kx, ky, kz, shear);
+}
+
+/// Entry distance of the ray into [bmin, bmax] within [0, t_far], or F32_MAX for a miss (robust slab test with
+/// min/max, so a negative inverse direction needs no swap).
+fn ray_box_entry(r: TraceRay, bmin: vec3<f32>, bmax: vec3<f32>, t_far: f32) -> f32 {
+    let t0 = (bmin - r.o) * r.inv_d;
+    let t1 = (bmax - r.o) * r.inv_d;
+    let tn = min(t0, t1);
+    let tf = max(t0, t1);
+    let enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    let leave = min(min(tf.x, tf.y), tf.z) * BVH_SLAB_FAR_SCALE;
+    return select(F32_MAX, enter, enter <= min(leave, t_far));
+}
+
+/// One edge function of the watertight test, U/V/W = p.x·q.y − p.y·q.x in the sheared 2D frame. The paper
+/// re-evaluates an exact 0 in double precision so that adjacent triangles agree on its sign; we instead evaluate
+/// every edge with its endpoints in a canonical (lexicographic) order and negate afterwards. The two triangles
+/// sharing an edge then compute bit-identical values with opposite signs whatever the compiler does (lavapipe
+/// reassociates and contracts to fma, which breaks the paper's assumption that e(p,q) = −e(q,p) in floats), so
+/// a ray through the edge hits at least one of them; a value of exactly 0 counts as inside for both (a tie, not a
+/// hole). No f64 needed.
+fn tri_edge(p: vec2<f32>, q: vec2<f32>) -> f32 {
+    let swap = q.x < p.x || (q.x == p.x && q.y < p.y);
+    let a = select(p, q, swap);
+    let b = select(q, p, swap);
+    let e = a.x * b.y - a.y * b.x;
+    return select(e, -e, swap);
+}
+
+/// A vertex relative to the ray origin, permuted and sheared (paper, Fig. 2). Shared vertices give identical bits
+/// in every triangle because the same code runs on the same values.
+fn tri_vertex(r: TraceRay, v: vec3<f32>) -> vec3<f32> {
+    let a = v - r.o;
+    let az = a[r.kz];
+    return vec3<f32>(a[r.kx] - r.shear.x * az, a[r.ky] - r.shear.y * az, r.shear.z * az);
+}
+
+/// Watertight ray–triangle test (Woop, Benthin, Wald 2013). Returns (t, b1, b2, 1) for a hit with t in (0, t_max),
+/// (b1, b2) the barycentrics of v1, v2; w = 0 for a miss. Both faces; NaN inputs miss (ordered compares).
+fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_max: f32) -> vec4<f32> {
+    let a = tri_vertex(r, v0);
+    let b = tri_vertex(r, v1);
+    let c = tri_vertex(r, v2);
+    let u = tri_edge(c.xy, b.xy);
+    let v = tri_edge(a.xy, c.xy);
+    let w = tri_edge(b.xy, a.xy);
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let inv_det = 1.0 / det;
+    let t = (u * a.z + v * b.z + w * c.z) * inv_det;
+    if !(t > 0.0 && t < t_max) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(t, v * inv_det, w * inv_det, 1.0);
+}
+
+/// Ray–sphere test, the cancellation-free form of Haines et al. 2019, "Precision Improvements for Ray/Sphere
+/// Intersection" (Ray Tracing Gems ch. 7, eqs. 7.9–7.14): the discriminant from the distance of the centre to the
+/// ray's line (accurate for far/small spheres), the roots as c/q and q/a. Returns (t, 0, 0, 1) for the nearest
+/// root in (0, t_max) (the far one from inside), w = 0 for a miss. `d` need not be normalised.
+fn intersect_sphere(o: vec3<f32>, d: vec3<f32>, center: vec3<f32>, radius: f32, t_max: f32) -> vec4<f32> {
+    let f = o - center;
+    let a = dot(d, d);
+    let b = -dot(f, d);
+    let l = f + (b / a) * d;
+    let r2 = radius * radius;
+    let disc = r2 - dot(l, l);
+    if !(disc >= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let q = b + select(1.0, -1.0, b < 0.0) * sqrt(a * disc);
+    let c = dot(f, f) - r2;
+    let t0 = c / q;
+    let t1 = q / a;
+    // select(), not min/max: min(NaN, x) = x on lavapipe would turn a NaN root into a hit.
+    let near = select(t1, t0, t0 < t1);
+    let far = select(t0, t1, t0 < t1);
+    if near > 0.0 && near < t_max {
+        return vec4<f32>(near, 0.0, 0.0, 1.0);
+    }
+    if far > 0.0 && far < t_max {
+        return vec4<f32>(far, 0.0, 0.0, 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+/// Ray–parallelogram test: the plane of corner + s·edge_u + t·edge_v, then (s, t) from cross products with the
+/// normal n = edge_u × edge_v. Returns (t, s, t_param, 1) for a hit with s, t_param ∈ [0, 1], w = 0 for a miss.
+fn intersect_quad(o: vec3<f32>, d: vec3<f32>, q: Quad, t_max: f32) -> vec4<f32> {
+    let n = cross(q.edge_u, q.edge_v);
+    let denom = dot(n, d);
+    let rel_o = o - q.corner;
+    let t = -dot(n, rel_o) / denom;
+    if !(t > 0.0 && t < t_max) || denom == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let p = rel_o + t * d;
+    let inv_nn = 1.0 / dot(n, n);
+    let s = dot(cross(p, q.edge_v), n) * inv_nn;
+    let tt = dot(cross(q.edge_u, p), n) * inv_nn;
+    if !(s >= 0.0 && s <= 1.0 && tt >= 0.0 && tt <= 1.0) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(t, s, tt, 1.0);
+}
+
+/// Intersects one primitive reference (kind << 30 | index); (t, b1, b2, 1) for a hit in (0, t_max), w = 0 for a miss.
+fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
+    let i = prim_index(prim);
+    switch prim_kind(prim) {
+        case PRIM_TRIANGLE: {
+            let v0 = tri_verts[3u * i].xyz;
+            let v1 = tri_verts[3u * i + 1u].xyz;
+            let v2 = tri_verts[3u * i + 2u].xyz;
+            return intersect_triangle(r, v0, v1, v2, t_max);
+        }
+        case PRIM_SPHERE: {
+            let s = spheres[i];
+            return intersect_sphere(r.o, r.d, s.center, s.radius, t_max);
+        }
+        case PRIM_QUAD: {
+            return intersect_quad(r.o, r.d, quads[i], t_max);
+        }
+        default: {
+            return vec4<f32>(0.0);
+        }
+    }
+}
+
+/// Stack-based BVH2 traversal shared by trace_closest and trace_any. Children are visited near-first by entry
+/// distance; a leaf child is intersected in its parent's step, an interior far child is pushed with its entry
+/// distance and skipped on pop if a closer hit has been found since. Each step consumes one interior node and
+/// every node is visited at most once, so the node count bounds the loop.
+fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool) -> Hit {
+    var hit = Hit(t_max, INVALID, 0.0, 0.0);
+    // NaN/Inf rays, a zero direction or a NaN or non-positive t_max can hit nothing.
+    if any_nonfinite3(o) || any_nonfinite3(d) || all(d == vec3<f32>(0.0)) || !(t_max > 0.0) {
+        return hit;
+    }
+    let r = trace_ray_setup(o, d);
+    var stack_node: array<u32, BVH_STACK_SIZE>;
+    var stack_t: array<f32, BVH_STACK_SIZE>;
+    var sp = 0u;
+    var node_index = 0u;
+    let max_steps = arrayLength(&bvh_nodes) + 1u;
+    for (var step = 0u; step < max_steps; step++) {
+        let node = bvh_nodes[node_index];
+        let l_valid = node.l_count > 0u || node.l_first != INVALID;
+        let r_valid = node.r_count > 0u || node.r_first != INVALID;
+        var tl = ray_box_entry(r, node.lmin, node.lmax, hit.t);
+        var tr = ray_box_entry(r, node.rmin, node.rmax, hit.t);
+        tl = select(F32_MAX, tl, l_valid);
+        tr = select(F32_MAX, tr, r_valid);
+        let right_first = tr < tl;
+        let near_t = select(tl, tr, right_first);
+        let far_t = select(tr, tl, right_first);
+        let near_first = select(node.l_first, node.r_first, right_first);
+        let near_count = select(node.l_count, node.r_count, right_first);
+        let far_first = select(node.r_first, node.l_first, right_first);
+        let far_count = select(node.r_count, node.l_count, right_first);
+
+        var next = INVALID;
+        for (var c = 0u; c < 2u; c++) {
+            let ct = select(far_t, near_t, c == 0u);
+            let first = select(far_first, near_first, c == 0u);
+            let count = select(far_count, near_count, c == 0u);
+            // Re-test against hit.t: the near leaf may have shortened the ray.
+            if !(ct <= hit.t) || ct == F32_MAX {
+                continue;
+            }
+            if count > 0u {
+                let n = min(count, BVH_MAX_LEAF_PRIMS);
+                for (var k = 0u; k < n; k++) {
+                    let prim = prim_refs[first + k];
+                    let h = intersect_prim(r, prim, hit.t);
+                    if h.w != 0.0 {
+                        hit = Hit(h.x, prim, h.y, h.z);
+                        if any_hit {
+                            return hit;
+                        }
+                    }
+                }
+            } else if next == INVALID {
+                next = first;
+            } else if sp < BVH_STACK_SIZE {
+                stack_node[sp] = first;
+                stack_t[sp] = ct;
+                sp += 1u;
+            }
+        }
+        // Nothing to descend into: pop, dropping subtrees entered beyond the closest hit.
+        for (var k = 0u; k < BVH_STACK_SIZE && next == INVALID && sp > 0u; k++) {
+            sp -= 1u;
+            if stack_t[sp] <= hit.t {
+                next = stack_node[sp];
+            }
+        }
+        if next == INVALID {
+            break;
+        }
+        node_index = next;
+    }
+    return hit;
+}
+
+/// Closest hit with t in (0, t_max). On a miss prim = INVALID and t = t_max. Triangles: (b1, b2) = barycentrics of
+/// v1, v2; quads: (s, t) along edge_u, edge_v; spheres: unused (0). Both faces of everything are hit.
+fn trace_closest(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+    return bvh_traverse(o, d, t_max, false);
+}
+
+/// Whether anything is hit with t in (0, t_max) (shadow rays); returns at the first hit found.
+fn trace_any(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
+    return bvh_traverse(o, d, t_max, true).prim != INVALID;
+}
+
+/// Spawn point for a ray leaving a surface at p, offset along the geometric normal `ng` (unit length, oriented
+/// to the side the new ray leaves from). Wächter & Binder 2019, "A Fast and Robust Method for Avoiding
+/// Self-Intersection" (Ray Tracing Gems ch. 6, listing 6-1): an offset of 256·ng integer ULPs, which scales with
+/// the magnitude of p, and a fixed float offset of ng/65536 near the origin (|p| < 1/32) where ULPs get tiny.
+fn offset_ray_origin(p: vec3<f32>, ng: vec3<f32>) -> vec3<f32> {
+    let of_i = vec3<i32>(256.0 * ng);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    let p_f = p + (1.0 / 65536.0) * ng;
+    return select(p_i, p_f, abs(p) < vec3<f32>(1.0 / 32.0));
+}

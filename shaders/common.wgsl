@@ -1,0 +1,219 @@
+// common.wgsl — constants and the structs shared with Rust (mirrored in src/gpu_types.rs, layout-tested).
+
+const PI: f32 = 3.14159265358979323846;
+const INV_PI: f32 = 0.31830988618379067154;
+const TWO_PI: f32 = 6.28318530717958647692;
+const INV_TWO_PI: f32 = 0.15915494309189533577;
+const INV_FOUR_PI: f32 = 0.07957747154594766788;
+const F32_MAX: f32 = 3.40282347e38;
+const INVALID: u32 = 0xffffffffu;
+const ONE_MINUS_EPSILON: f32 = 0.99999994;
+
+// Primitive references (BVH leaves): kind in the top two bits, index in the rest.
+const PRIM_TRIANGLE: u32 = 0u;
+const PRIM_SPHERE: u32 = 1u;
+const PRIM_QUAD: u32 = 2u;
+const PRIM_KIND_SHIFT: u32 = 30u;
+const PRIM_INDEX_MASK: u32 = 0x3fffffffu;
+
+// Light kinds (Light.kind).
+const LIGHT_TRIANGLE: u32 = 0u;
+const LIGHT_SPHERE: u32 = 1u;
+const LIGHT_QUAD: u32 = 2u;
+const LIGHT_POINT: u32 = 3u;
+const LIGHT_SPOT: u32 = 4u;
+const LIGHT_DIRECTIONAL: u32 = 5u;
+const LIGHT_ENVIRONMENT: u32 = 6u;
+
+// Settings tags (mirrored by the Rust enums in src/settings.rs).
+const MODE_DIRECT: u32 = 0u;
+const MODE_PATH: u32 = 1u;
+
+const STRATEGY_UNIFORM: u32 = 0u;
+const STRATEGY_COSINE: u32 = 1u;
+const STRATEGY_BSDF: u32 = 2u;
+const STRATEGY_LIGHT: u32 = 3u;
+const STRATEGY_MIS: u32 = 4u;
+
+const LIGHT_SAMPLING_AREA: u32 = 0u;
+const LIGHT_SAMPLING_SOLID_ANGLE: u32 = 1u;
+
+const ENV_SAMPLING_UNIFORM: u32 = 0u;
+const ENV_SAMPLING_IMPORTANCE: u32 = 1u;
+
+const LIGHT_SELECT_UNIFORM: u32 = 0u;
+const LIGHT_SELECT_POWER: u32 = 1u;
+
+const HEURISTIC_BALANCE: u32 = 0u;
+const HEURISTIC_POWER: u32 = 1u;
+
+const MIS_MULTI: u32 = 0u;
+const MIS_ONE: u32 = 1u;
+
+const SAMPLER_INDEPENDENT: u32 = 0u;
+const SAMPLER_STRATIFIED: u32 = 1u;
+const SAMPLER_HALTON: u32 = 2u;
+const SAMPLER_HAMMERSLEY: u32 = 3u;
+const SAMPLER_SOBOL: u32 = 4u;
+const SAMPLER_BLUE_NOISE: u32 = 5u;
+
+// Texture wrap modes (TextureInfo.wrap_s / wrap_t).
+const WRAP_REPEAT: u32 = 0u;
+const WRAP_CLAMP: u32 = 1u;
+const WRAP_MIRROR: u32 = 2u;
+
+/// An analytic sphere. Emission, if any, comes from its material; `light` indexes the light table.
+struct Sphere {
+    center: vec3<f32>,
+    radius: f32,
+    material: u32,
+    light: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+/// An analytic parallelogram: corner + s·edge_u + t·edge_v, s,t ∈ [0,1]; front face along cross(edge_u, edge_v).
+struct Quad {
+    corner: vec3<f32>,
+    material: u32,
+    edge_u: vec3<f32>,
+    light: u32,
+    edge_v: vec3<f32>,
+    _pad0: u32,
+}
+
+/// Per-triangle shading data (positions live in `tri_verts`, three vec4 per triangle).
+struct TriShading {
+    n0: vec3<f32>,
+    material: u32,
+    n1: vec3<f32>,
+    light: u32,
+    n2: vec3<f32>,
+    _pad0: u32,
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
+    _pad1: vec2<u32>,
+}
+
+/// glTF metallic-roughness material (KHR_materials_specular's specularFactor included).
+/// Lambert = {metallic 0, specular 0}; GGX conductor with F = 1 = {metallic 1, base colour = reflectance}.
+/// Texture slots hold an index into `tex_info` or INVALID; uv transforms are 2×3 affine (rows xform_*0, xform_*1).
+struct Material {
+    base_color: vec3<f32>,
+    metallic: f32,
+    emission: vec3<f32>,
+    alpha: f32,            // GGX α = roughness², clamped to ALPHA_MIN at load
+    specular: f32,
+    base_tex: u32,
+    mr_tex: u32,
+    emissive_tex: u32,
+    base_xform0: vec4<f32>, // (a, b, c, texcoord): u' = a·u + b·v + c
+    base_xform1: vec4<f32>, // (d, e, f, 0):        v' = d·u + e·v + f
+    mr_xform0: vec4<f32>,
+    mr_xform1: vec4<f32>,
+    em_xform0: vec4<f32>,
+    em_xform1: vec4<f32>,
+}
+
+/// One entry of the light table. For area lights `prim` indexes triangles/spheres/quads; for
+/// punctual lights `position`/`direction` are used. `pmf` is this light's selection probability under
+/// the active light-selection scheme (power or uniform), so MIS can evaluate it in O(1).
+struct Light {
+    position: vec3<f32>,
+    kind: u32,
+    direction: vec3<f32>,
+    prim: u32,
+    radiance: vec3<f32>,   // emitted radiance (area), intensity (point/spot), irradiance (directional), scale (env)
+    pmf_power: f32,
+    cos_inner: f32,
+    cos_outer: f32,
+    area: f32,
+    pmf_uniform: f32,
+}
+
+/// Alias-table entry: take `index` with probability `prob`, else `alias`.
+struct AliasEntry {
+    prob: f32,
+    alias_index: u32,
+}
+
+/// Where a texture's texels start in `tex_texels` (RGBA8, one u32 per texel) and how to read them.
+struct TextureInfo {
+    offset: u32,
+    width: u32,
+    height: u32,
+    wrap_s: u32,
+    wrap_t: u32,
+    srgb: u32,
+    nearest: u32,
+    _pad0: u32,
+}
+
+/// Per-pixel accumulation: running mean and sum of squared deviations (Welford/Chan), sample count,
+/// and the number of non-finite samples that were counted and left out.
+struct Accum {
+    mean: vec3<f32>,
+    count: u32,
+    m2: vec3<f32>,
+    nonfinite: u32,
+}
+
+/// Everything a dispatch needs to know that is not scene data: camera, film, settings.
+struct FrameParams {
+    width: u32,
+    height: u32,
+    sample_base: u32,
+    samples_per_dispatch: u32,
+    seed: u32,
+    mode: u32,
+    max_depth: u32,
+    strategy: u32,
+    light_sampling: u32,
+    env_sampling: u32,
+    light_select: u32,
+    heuristic: u32,
+    power_beta: f32,
+    light_samples: u32,
+    bsdf_samples: u32,
+    mis_kind: u32,
+    sampler: u32,
+    num_lights: u32,
+    rr_depth: u32,
+    env_light: u32,
+    cam_origin: vec3<f32>,
+    tan_half_fov: f32,
+    cam_right: vec3<f32>,
+    aspect: f32,
+    cam_up: vec3<f32>,
+    env_scale: f32,
+    cam_forward: vec3<f32>,
+    env_rotation: f32,
+    env_constant: vec3<f32>,
+    env_width: u32,
+    env_height: u32,
+    sampler_spp: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+/// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;
+/// (b1, b2) are barycentrics of v1, v2 for triangles, (s, t) for quads, unused for spheres.
+struct Hit {
+    t: f32,
+    prim: u32,
+    b1: f32,
+    b2: f32,
+}
+
+fn prim_kind(prim: u32) -> u32 { return prim >> PRIM_KIND_SHIFT; }
+fn prim_index(prim: u32) -> u32 { return prim & PRIM_INDEX_MASK; }
+fn make_prim(kind: u32, index: u32) -> u32 { return (kind << PRIM_KIND_SHIFT) | index; }
+
+/// True for NaN and ±Inf. Tests the exponent bits: `x != x` is compiled as an ordered compare and misses NaN.
+fn is_nonfinite(x: f32) -> bool { return (bitcast<u32>(x) & 0x7f800000u) == 0x7f800000u; }
+fn any_nonfinite3(v: vec3<f32>) -> bool { return is_nonfinite(v.x) || is_nonfinite(v.y) || is_nonfinite(v.z); }
+
+fn luminance(c: vec3<f32>) -> f32 { return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722)); }
+fn sqr(x: f32) -> f32 { return x * x; }
+fn safe_sqrt(x: f32) -> f32 { return sqrt(max(x, 0.0)); }

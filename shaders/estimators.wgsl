@@ -1,0 +1,202 @@
+// estimators.wgsl — the lecture's shade(x, V, brdf, N): direct illumination at a shading point, built
+// from techniques that sample / pdf / eval. Two families of techniques:
+//   * direction techniques (uniform hemisphere, cosine hemisphere, BSDF): sample w, trace, find emitters;
+//   * light techniques (lights.wgsl): sample a point/direction on an emitter, test a shadow ray.
+// `--strategy` picks which run; `mis` runs both and weights them (multi-sample or one-sample MIS).
+
+/// What shade() returns: the estimate, and (for path tracing) the continuation ray it traced anyway.
+struct Shaded {
+    radiance: vec3<f32>,
+    next_valid: bool,
+    next_origin: vec3<f32>,
+    next_dir: vec3<f32>,
+    next_weight: vec3<f32>,   // f·cos/pdf of the continuation direction
+    next_hit: Hit,
+}
+
+/// The shading point as the techniques see it.
+struct ShadingCtx {
+    x: Surface,
+    frame: Frame,
+    wo: vec3<f32>,        // V in the local frame
+    brdf: BsdfParams,
+    id: SampleId,
+    bounce: u32,
+}
+
+/// The direction technique a strategy uses: uniform, cosine, or the BSDF (also for light / mis).
+fn direction_technique() -> u32 {
+    if (params.strategy == STRATEGY_UNIFORM || params.strategy == STRATEGY_COSINE) { return params.strategy; }
+    return STRATEGY_BSDF;
+}
+
+/// pdf (solid angle) of the direction technique producing local direction wi.
+fn direction_pdf(c: ShadingCtx, wi: vec3<f32>) -> f32 {
+    switch (direction_technique()) {
+        case STRATEGY_UNIFORM: { return square_to_uniform_hemisphere_pdf(wi); }
+        case STRATEGY_COSINE: { return square_to_cosine_hemisphere_pdf(wi); }
+        default: { return bsdf_pdf(c.brdf, c.wo, wi); }
+    }
+}
+
+/// Samples the direction technique: local wi and its pdf (0 = failed).
+fn direction_sample(c: ShadingCtx, j: u32) -> vec4<f32> {
+    let base = dim_base(c.bounce, j);
+    let u = sample_2d(c.id, base + DIM_BSDF_UV);
+    switch (direction_technique()) {
+        case STRATEGY_UNIFORM: {
+            let w = square_to_uniform_hemisphere(u);
+            return vec4<f32>(w, square_to_uniform_hemisphere_pdf(w));
+        }
+        case STRATEGY_COSINE: {
+            let w = square_to_cosine_hemisphere(u);
+            return vec4<f32>(w, square_to_cosine_hemisphere_pdf(w));
+        }
+        default: {
+            let s = bsdf_sample(c.brdf, c.wo, sample_1d(c.id, base + DIM_BSDF_LOBE), u);
+            return vec4<f32>(s.wi, s.pdf);
+        }
+    }
+}
+
+/// Spawns a ray leaving the surface along world direction w (offset to the side w points to).
+fn spawn_origin(x: Surface, w: vec3<f32>) -> vec3<f32> {
+    return offset_ray_origin(x.p, select(-x.ng, x.ng, dot(w, x.ng) > 0.0));
+}
+
+/// One light-technique sample: choose a light, sample it, test visibility, weight against the
+/// direction technique when `mis_n_dir` > 0 (its sample count; 0 = no MIS partner).
+fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f32> {
+    if (params.num_lights == 0u) { return vec3<f32>(0.0); }
+    let base = dim_base(c.bounce, j);
+    let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT));
+    let pmf = light_pmf(li);
+    let u = vec3<f32>(sample_2d(c.id, base + DIM_LIGHT_UV), sample_1d(c.id, base + DIM_LIGHT_EXTRA));
+    let ls = light_sample_li(li, c.x.p, u);
+    if (!(ls.pdf > 0.0) || !(pmf > 0.0)) { return vec3<f32>(0.0); }
+    // Reflection only: the light must be above both the shading and the geometric hemisphere.
+    let cos_s = dot(ls.wi, c.x.ns);
+    if (cos_s <= 0.0 || dot(ls.wi, c.x.ng) <= 0.0) { return vec3<f32>(0.0); }
+    let wi_local = to_local(c.frame, ls.wi);
+    let f = bsdf_eval(c.brdf, c.wo, wi_local);
+    if (all(f * ls.radiance == vec3<f32>(0.0))) { return vec3<f32>(0.0); }
+    let o = spawn_origin(c.x, ls.wi);
+    // Stop just short of the light point so the emitter itself does not count as an occluder.
+    let t_max = select(ls.dist * (1.0 - 2e-5), F32_MAX, ls.dist >= F32_MAX);
+    rays_traced += 1u;
+    if (trace_any(o, ls.wi, t_max)) { return vec3<f32>(0.0); }
+    let p_light = pmf * ls.pdf;
+    var w = 1.0;
+    if (mis_n_dir > 0.0 && !ls.delta) {
+        w = mis_weight(n_light, p_light, mis_n_dir, direction_pdf(c, wi_local));
+    }
+    return w * ls.radiance * f * cos_s / p_light;
+}
+
+/// Emitted radiance found by a traced direction, and the light technique's pdf for it (with selection).
+struct Found {
+    le: vec3<f32>,
+    p_light: f32,
+}
+
+fn found_emission(c: ShadingCtx, w: vec3<f32>, hit: Hit) -> Found {
+    var r = Found(vec3<f32>(0.0), 0.0);
+    if (hit.prim == INVALID) {
+        if (params.env_light != INVALID) {
+            r.le = env_eval(w);
+            r.p_light = light_pmf(params.env_light) * env_pdf(w);
+        }
+        return r;
+    }
+    let y = surface_at(hit, c.x.p, w);
+    if (!y.front) { return r; }
+    r.le = material_emission(materials[y.material], y.uv);
+    if (y.light != INVALID) {
+        // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
+        r.p_light = light_pmf(y.light) * light_pdf_li(y.light, c.x.p, w, y.p, y.ng);
+    }
+    return r;
+}
+
+/// shade(x, V, brdf, N): the direct-illumination estimate at one shading point, by the active strategy.
+/// When `want_next`, also returns a continuation direction for path tracing (the first direction
+/// sample, reused, or a fresh BSDF sample when the strategy traced none).
+fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
+    var out: Shaded;
+    out.radiance = vec3<f32>(0.0);
+    out.next_valid = false;
+    var n_light = 0u;
+    var n_dir = 0u;
+    var one_sample = false;
+    switch (params.strategy) {
+        case STRATEGY_LIGHT: { n_light = params.light_samples; }
+        case STRATEGY_MIS: {
+            n_light = params.light_samples;
+            n_dir = params.bsdf_samples;
+            one_sample = params.mis_kind == MIS_ONE;
+        }
+        default: { n_dir = params.bsdf_samples; }
+    }
+    let mis = params.strategy == STRATEGY_MIS;
+    var dir_count = n_dir;
+    if (one_sample) {
+        // One-sample MIS: pick the light technique with probability c_l = n_l / (n_l + n_d); the
+        // estimate is w_i·f/(c_i·p_i) for the chosen technique i (Veach §9.2.4).
+        let c_l = f32(n_light) / f32(n_light + n_dir);
+        let choose_light = sample_1d(c.id, dim_base(c.bounce, 0u) + DIM_MIS_CHOICE) < c_l;
+        if (choose_light) {
+            out.radiance += light_estimate(c, 0u, f32(n_light), f32(n_dir)) / c_l;
+            dir_count = 0u;
+        } else {
+            dir_count = 1u;
+        }
+        n_light = 0u;
+    }
+    for (var j = 0u; j < min(n_light, 64u); j += 1u) {
+        out.radiance += light_estimate(c, j, f32(n_light), select(0.0, f32(n_dir), mis)) / f32(n_light);
+    }
+    // Direction samples: trace, and count what they find (weighted against light sampling under MIS).
+    let dir_scale = select(1.0 / f32(max(n_dir, 1u)), 1.0 / (1.0 - f32(params.light_samples) / f32(params.light_samples + n_dir)), one_sample);
+    for (var j = 0u; j < min(dir_count, 64u); j += 1u) {
+        let ds = direction_sample(c, j);
+        let wl = ds.xyz;
+        let pdf = ds.w;
+        if (!(pdf > 0.0)) { continue; }
+        let w = to_world(c.frame, wl);
+        if (dot(w, c.x.ng) <= 0.0) { continue; }
+        let f = bsdf_eval(c.brdf, c.wo, wl);
+        let o = spawn_origin(c.x, w);
+        rays_traced += 1u;
+        let hit = trace_closest(o, w, F32_MAX);
+        let found = found_emission(c, w, hit);
+        var weight = 1.0;
+        if (mis) { weight = mis_weight(f32(n_dir), pdf, f32(params.light_samples), found.p_light); }
+        out.radiance += weight * found.le * f * wl.z / pdf * dir_scale;
+        if (j == 0u && want_next) {
+            out.next_valid = true;
+            out.next_origin = o;
+            out.next_dir = w;
+            out.next_weight = f * wl.z / pdf;
+            out.next_hit = hit;
+        }
+    }
+    if (want_next && !out.next_valid) {
+        // The strategy traced no direction here (light sampling, or one-sample MIS chose the light):
+        // continue the path with a BSDF sample whose emission is not counted (NEE already did).
+        let base = dim_base(c.bounce, 0u);
+        let s = bsdf_sample(c.brdf, c.wo, sample_1d(c.id, base + DIM_BSDF_LOBE), sample_2d(c.id, base + DIM_BSDF_UV));
+        if (s.pdf > 0.0) {
+            let w = to_world(c.frame, s.wi);
+            if (dot(w, c.x.ng) > 0.0) {
+                let o = spawn_origin(c.x, w);
+                out.next_valid = true;
+                out.next_origin = o;
+                out.next_dir = w;
+                out.next_weight = s.f * s.wi.z / s.pdf;
+                rays_traced += 1u;
+                out.next_hit = trace_closest(o, w, F32_MAX);
+            }
+        }
+    }
+    return out;
+}

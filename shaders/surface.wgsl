@@ -1,0 +1,136 @@
+// surface.wgsl — from a hit to a shading point: position, normals, uv, material with textures applied.
+
+/// A shading point. `ng`/`ns` are flipped to the side the ray came from; `front` says whether the ray
+/// hit the front (emitting) face; `light` is the emitter's index in the light table or INVALID.
+struct Surface {
+    p: vec3<f32>,
+    ng: vec3<f32>,
+    ns: vec3<f32>,
+    uv: vec2<f32>,
+    material: u32,
+    light: u32,
+    front: bool,
+}
+
+/// Hit position, geometric normal (unflipped, the emitting side) etc. for any primitive kind.
+fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
+    var s: Surface;
+    let kind = prim_kind(hit.prim);
+    let i = prim_index(hit.prim);
+    var ng: vec3<f32>;
+    var ns: vec3<f32>;
+    if (kind == PRIM_TRIANGLE) {
+        let v0 = tri_verts[3u * i].xyz;
+        let v1 = tri_verts[3u * i + 1u].xyz;
+        let v2 = tri_verts[3u * i + 2u].xyz;
+        let b0 = 1.0 - hit.b1 - hit.b2;
+        // Barycentric interpolation keeps the point on the triangle's plane (o + t·d drifts off it).
+        s.p = b0 * v0 + hit.b1 * v1 + hit.b2 * v2;
+        ng = normalize(cross(v1 - v0, v2 - v0));
+        let sh = tri_shading[i];
+        ns = b0 * sh.n0 + hit.b1 * sh.n1 + hit.b2 * sh.n2;
+        s.uv = b0 * sh.uv0 + hit.b1 * sh.uv1 + hit.b2 * sh.uv2;
+        s.material = sh.material;
+        s.light = sh.light;
+    } else if (kind == PRIM_SPHERE) {
+        let sp = spheres[i];
+        let q = o + hit.t * d;
+        ng = normalize(q - sp.center);
+        s.p = sp.center + sp.radius * ng;   // re-projected onto the sphere
+        ns = ng;
+        s.uv = vec2<f32>(atan2(ng.z, ng.x) * INV_TWO_PI + 0.5, acos(clamp(ng.y, -1.0, 1.0)) * INV_PI);
+        s.material = sp.material;
+        s.light = sp.light;
+    } else {
+        let q = quads[i];
+        s.p = q.corner + hit.b1 * q.edge_u + hit.b2 * q.edge_v;
+        ng = normalize(cross(q.edge_u, q.edge_v));
+        ns = ng;
+        s.uv = vec2<f32>(hit.b1, hit.b2);
+        s.material = q.material;
+        s.light = q.light;
+    }
+    // A degenerate or non-finite interpolated normal falls back to the geometric one.
+    let ns_len2 = dot(ns, ns);
+    if (!(ns_len2 > 1e-12) || is_nonfinite(ns_len2)) { ns = ng; } else { ns = ns * inverseSqrt(ns_len2); }
+    s.front = dot(d, ng) < 0.0;
+    let flip = select(-1.0, 1.0, s.front);
+    s.ng = ng * flip;
+    s.ns = ns * flip;
+    // Keep the shading normal on the viewer's side of the geometric one.
+    if (dot(s.ns, -d) <= 0.0) { s.ns = s.ng; }
+    return s;
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if (c <= 0.04045) { return c / 12.92; }
+    return pow((c + 0.055) / 1.055, 2.4);
+}
+
+fn wrap_coord(x: i32, n: i32, mode: u32) -> i32 {
+    if (mode == WRAP_CLAMP) { return clamp(x, 0, n - 1); }
+    if (mode == WRAP_MIRROR) {
+        let period = 2 * n;
+        var m = x % period;
+        if (m < 0) { m += period; }
+        return select(m, period - 1 - m, m >= n);
+    }
+    var m = x % n;
+    if (m < 0) { m += n; }
+    return m;
+}
+
+fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
+    let xi = wrap_coord(x, i32(info.width), info.wrap_s);
+    let yi = wrap_coord(y, i32(info.height), info.wrap_t);
+    var c = unpack4x8unorm(tex_texels[info.offset + u32(yi) * info.width + u32(xi)]);
+    if (info.srgb != 0u) {
+        c = vec4<f32>(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w);
+    }
+    return c;
+}
+
+/// Bilinear (or nearest) lookup with the texture's wrap modes, after the 2×3 uv transform.
+fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) -> vec4<f32> {
+    let info = tex_info[tex];
+    let uv = vec2<f32>(dot(xf0.xyz, vec3<f32>(uv_in, 1.0)), dot(xf1.xyz, vec3<f32>(uv_in, 1.0)));
+    if (is_nonfinite(uv.x) || is_nonfinite(uv.y)) { return vec4<f32>(0.0); }
+    let st = uv * vec2<f32>(f32(info.width), f32(info.height)) - 0.5;
+    // Keep coordinates in i32 range before the wrap (huge uvs would overflow).
+    let stc = clamp(st, vec2<f32>(-1e8), vec2<f32>(1e8));
+    if (info.nearest != 0u) {
+        return texel(info, i32(floor(stc.x + 0.5)), i32(floor(stc.y + 0.5)));
+    }
+    let f = floor(stc);
+    let w = stc - f;
+    let x = i32(f.x);
+    let y = i32(f.y);
+    let a = mix(texel(info, x, y), texel(info, x + 1, y), w.x);
+    let b = mix(texel(info, x, y + 1), texel(info, x + 1, y + 1), w.x);
+    return mix(a, b, w.y);
+}
+
+/// The material's BSDF parameters at `uv`.
+fn material_bsdf(m: Material, uv: vec2<f32>) -> BsdfParams {
+    var p = BsdfParams(m.base_color, m.metallic, m.alpha, m.specular);
+    if (m.base_tex != INVALID) {
+        p.base_color *= texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
+    }
+    if (m.mr_tex != INVALID) {
+        let mr = texture_lookup(m.mr_tex, m.mr_xform0, m.mr_xform1, uv);
+        // glTF: roughness in G, metallic in B; α = roughness².
+        let rough = sqrt(m.alpha) * mr.y;
+        p.alpha = max(rough * rough, 1e-4);
+        p.metallic *= mr.z;
+    }
+    return p;
+}
+
+/// Emitted radiance of the material at `uv` (front face only; callers check `front`).
+fn material_emission(m: Material, uv: vec2<f32>) -> vec3<f32> {
+    var e = m.emission;
+    if (m.emissive_tex != INVALID) {
+        e *= texture_lookup(m.emissive_tex, m.em_xform0, m.em_xform1, uv).xyz;
+    }
+    return e;
+}

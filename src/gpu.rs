@@ -1,0 +1,215 @@
+//! The GPU context: one Vulkan adapter + device, chosen by `WGPU_ADAPTER_NAME` or by preference,
+//! with the limits the renderer needs and helpers that never wait on the device without a timeout.
+
+use std::time::Duration;
+
+/// How long any single wait on the device may take before we give up (lavapipe has no watchdog).
+pub const DEVICE_WAIT_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Why no GPU context could be made. The CLI maps every variant to exit code 2.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No Vulkan adapter at all.
+    #[error(
+        "no Vulkan adapter found. mislab needs a Vulkan driver; on a machine without a GPU install the software \
+         rasterizer lavapipe (Debian/Ubuntu: `apt-get install mesa-vulkan-drivers`)"
+    )]
+    NoAdapter,
+    /// `WGPU_ADAPTER_NAME` matched none of the adapters.
+    #[error("WGPU_ADAPTER_NAME={wanted:?} matches no Vulkan adapter; available: {available}")]
+    NoMatchingAdapter { wanted: String, available: String },
+    /// The device could not be created.
+    #[error("could not open a device on '{adapter}': {source}")]
+    RequestDevice { adapter: String, source: wgpu::RequestDeviceError },
+    /// A wait on the device failed or timed out.
+    #[error("waiting on the GPU failed: {0}")]
+    Poll(String),
+    /// A buffer could not be mapped for readback.
+    #[error("reading back from the GPU failed: {0}")]
+    Map(String),
+}
+
+/// One adapter as `mislab info` prints it.
+#[derive(Clone, Debug)]
+pub struct AdapterSummary {
+    /// Adapter name (what `WGPU_ADAPTER_NAME` matches, case-insensitively, as a substring).
+    pub name: String,
+    /// Discrete / integrated / CPU / ...
+    pub device_type: wgpu::DeviceType,
+    /// Driver name and version.
+    pub driver: String,
+}
+
+/// Adapter, device and queue, plus what was learned about them.
+pub struct GpuContext {
+    /// The instance the adapter came from (kept alive for surfaces).
+    pub instance: wgpu::Instance,
+    /// The chosen adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Adapter information.
+    pub info: wgpu::AdapterInfo,
+    /// Whether timestamp queries work inside compute passes.
+    pub timestamps: bool,
+}
+
+fn summary(a: &wgpu::Adapter) -> AdapterSummary {
+    let i = a.get_info();
+    AdapterSummary { name: i.name, device_type: i.device_type, driver: format!("{} {}", i.driver, i.driver_info) }
+}
+
+fn vulkan_instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::VULKAN;
+    wgpu::Instance::new(desc)
+}
+
+/// Every Vulkan adapter on this machine.
+pub fn list_adapters() -> Vec<AdapterSummary> {
+    let instance = vulkan_instance();
+    pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN)).iter().map(summary).collect()
+}
+
+fn preference(t: wgpu::DeviceType) -> u32 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+impl GpuContext {
+    /// Opens a headless device: the adapter named by `WGPU_ADAPTER_NAME` (substring, case-insensitive)
+    /// or else the most capable one (discrete > integrated > ... > CPU).
+    pub fn new() -> Result<Self, GpuError> {
+        let instance = vulkan_instance();
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+        if adapters.is_empty() {
+            return Err(GpuError::NoAdapter);
+        }
+        let adapter = match std::env::var("WGPU_ADAPTER_NAME").ok().filter(|s| !s.is_empty()) {
+            Some(wanted) => {
+                let w = wanted.to_lowercase();
+                match adapters.iter().position(|a| a.get_info().name.to_lowercase().contains(&w)) {
+                    Some(i) => adapters.swap_remove(i),
+                    None => {
+                        let available = adapters.iter().map(|a| a.get_info().name).collect::<Vec<_>>().join(", ");
+                        return Err(GpuError::NoMatchingAdapter { wanted, available });
+                    }
+                }
+            }
+            None => {
+                adapters.sort_by_key(|a| preference(a.get_info().device_type));
+                adapters.swap_remove(0)
+            }
+        };
+        Self::from_adapter(instance, adapter)
+    }
+
+    /// Opens a device on a given adapter (the viewer picks one compatible with its surface).
+    pub fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+        let info = adapter.get_info();
+        let (features, limits) = Self::wanted(&adapter);
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("mislab"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|source| GpuError::RequestDevice { adapter: info.name.clone(), source })?;
+        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        Ok(GpuContext { instance, adapter, device, queue, info, timestamps })
+    }
+
+    /// The features and limits we ask for: everything the adapter offers that we use.
+    pub fn wanted(adapter: &wgpu::Adapter) -> (wgpu::Features, wgpu::Limits) {
+        let available = adapter.features();
+        let features = available & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES);
+        (features, adapter.limits())
+    }
+
+    /// The device's limits.
+    pub fn limits(&self) -> wgpu::Limits {
+        self.device.limits()
+    }
+
+    /// Largest storage-buffer binding, in bytes (what a scene buffer must fit in).
+    pub fn max_storage_binding(&self) -> u64 {
+        let l = self.limits();
+        (l.max_storage_buffer_binding_size as u64).min(l.max_buffer_size)
+    }
+
+    /// Waits for all submitted work, at most `DEVICE_WAIT_TIMEOUT`.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(DEVICE_WAIT_TIMEOUT) })
+            .map(|_| ())
+            .map_err(|e| GpuError::Poll(e.to_string()))
+    }
+
+    /// Copies `size` bytes of `src` (from offset 0) to the CPU. `src` needs COPY_SRC.
+    pub fn read_buffer(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        match rx.recv_timeout(Duration::from_secs(5)) {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(GpuError::Map(e.to_string())),
+            Err(_) => return Err(GpuError::Map("the map callback never ran".into())),
+        }
+        let data = staging.get_mapped_range(..).map_err(|e| GpuError::Map(format!("{e:?}")))?.to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// Reads a buffer of `count` Pod values.
+    pub fn read_pod<T: bytemuck::Pod>(&self, src: &wgpu::Buffer, count: usize) -> Result<Vec<T>, GpuError> {
+        let bytes = self.read_buffer(src, (count * std::mem::size_of::<T>()) as u64)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// A storage buffer initialised with `data` (at least 16 bytes, so empty tables still bind).
+    pub fn storage_buffer<T: bytemuck::Pod>(&self, label: &str, data: &[T], extra: wgpu::BufferUsages) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        let mut bytes = bytemuck::cast_slice::<T, u8>(data).to_vec();
+        let min = 16.max(std::mem::size_of::<T>());
+        if bytes.len() < min {
+            bytes.resize(min, 0);
+        }
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        })
+    }
+}
+
+/// The adapter summaries plus the limits that matter, as `mislab info` prints them.
+pub fn describe(ctx: &GpuContext) -> String {
+    let l = ctx.limits();
+    let mut s = String::new();
+    s += &format!("adapter: {} ({:?}, driver {} {})\n", ctx.info.name, ctx.info.device_type, ctx.info.driver, ctx.info.driver_info);
+    s += &format!("  max storage buffer binding: {} MiB\n", l.max_storage_buffer_binding_size as u64 >> 20);
+    s += &format!("  max buffer size: {} MiB\n", l.max_buffer_size >> 20);
+    s += &format!("  max storage buffers per stage: {}\n", l.max_storage_buffers_per_shader_stage);
+    s += &format!("  max workgroups per dimension: {}\n", l.max_compute_workgroups_per_dimension);
+    s += &format!("  max invocations per workgroup: {}\n", l.max_compute_invocations_per_workgroup);
+    s += &format!("  timestamp queries: {}\n", if ctx.timestamps { "yes" } else { "no" });
+    s
+}

@@ -1,0 +1,366 @@
+//! GpuScene: the scene flattened into the storage buffers the shaders read (geometry + BVH, shading
+//! data, light table, textures, environment distribution), with size checks against device limits.
+
+use crate::bvh;
+use crate::gpu::GpuContext;
+use crate::gpu_types::*;
+use crate::lights::{self, luminance};
+use crate::scene::{Environment, PunctualLight, Scene, TextureRef, Wrap};
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// CPU-side arrays exactly as uploaded, plus statistics. Built without a device so tests can inspect it.
+#[derive(Clone, Debug, Default)]
+pub struct SceneData {
+    /// Three vec4 per triangle.
+    pub tri_verts: Vec<[f32; 4]>,
+    /// Per-triangle shading data.
+    pub tri_shading: Vec<GpuTriShading>,
+    /// Spheres.
+    pub spheres: Vec<GpuSphere>,
+    /// Quads.
+    pub quads: Vec<GpuQuad>,
+    /// Materials.
+    pub materials: Vec<GpuMaterial>,
+    /// Light table.
+    pub lights: Vec<GpuLight>,
+    /// Alias table for power-proportional light selection.
+    pub light_alias: Vec<GpuAliasEntry>,
+    /// Texture table.
+    pub tex_info: Vec<GpuTextureInfo>,
+    /// All texels, RGBA8 packed.
+    pub tex_texels: Vec<u32>,
+    /// Environment texels (rgb + density), empty for none/constant.
+    pub env_texels: Vec<[f32; 4]>,
+    /// Environment alias table.
+    pub env_alias: Vec<GpuAliasEntry>,
+    /// Environment width/height (0 for none/constant).
+    pub env_size: (u32, u32),
+    /// Constant environment radiance (when no map).
+    pub env_constant: [f32; 3],
+    /// Map scale / rotation.
+    pub env_scale: f32,
+    /// Rotation about +Y, radians.
+    pub env_rotation: f32,
+    /// Index of the environment in the light table.
+    pub env_light: Option<u32>,
+    /// BVH nodes.
+    pub bvh_nodes: Vec<bvh::GpuBvhNode>,
+    /// BVH primitive references.
+    pub prim_refs: Vec<u32>,
+    /// BVH build time, seconds.
+    pub bvh_seconds: f64,
+    /// BVH SAH cost.
+    pub bvh_sah: f32,
+    /// Number of delta lights (reachable by light sampling only).
+    pub delta_lights: u32,
+}
+
+impl SceneData {
+    /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device.
+    pub fn build(scene: &Scene) -> SceneData {
+        let mut d = SceneData::default();
+        d.materials = scene.materials.iter().map(gpu_material).collect();
+        if d.materials.is_empty() {
+            d.materials.push(gpu_material(&Default::default()));
+        }
+        let mat_index = |m: u32| if (m as usize) < d.materials.len() { m } else { 0 };
+        let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
+        for mesh in &scene.meshes {
+            for t in &mesh.indices {
+                let p = t.map(|i| mesh.positions[i as usize]);
+                let n = t.map(|i| mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO));
+                let uv = t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default());
+                tris.push(p);
+                for v in p {
+                    d.tri_verts.push([v.x, v.y, v.z, 0.0]);
+                }
+                d.tri_shading.push(GpuTriShading {
+                    n0: n[0].into(),
+                    n1: n[1].into(),
+                    n2: n[2].into(),
+                    uv0: uv[0].into(),
+                    uv1: uv[1].into(),
+                    uv2: uv[2].into(),
+                    material: mat_index(mesh.material),
+                    light: INVALID,
+                    ..Default::default()
+                });
+            }
+        }
+        d.spheres = scene
+            .spheres
+            .iter()
+            .map(|s| GpuSphere { center: s.center.into(), radius: s.radius, material: mat_index(s.material), light: INVALID, ..Default::default() })
+            .collect();
+        d.quads = scene
+            .quads
+            .iter()
+            .map(|q| GpuQuad { corner: q.corner.into(), edge_u: q.edge_u.into(), edge_v: q.edge_v.into(), material: mat_index(q.material), light: INVALID, ..Default::default() })
+            .collect();
+        let bvh = bvh::build(&tris, &d.spheres, &d.quads);
+        d.bvh_seconds = bvh.build_seconds;
+        d.bvh_sah = bvh.sah_cost;
+        d.bvh_nodes = bvh.nodes;
+        d.prim_refs = bvh.prim_refs;
+        build_textures(scene, &mut d);
+        build_lights(scene, &tris, &mut d);
+        d
+    }
+
+    /// Bytes of geometry + BVH per triangle (0 without triangles).
+    pub fn bvh_bytes(&self) -> usize {
+        self.bvh_nodes.len() * std::mem::size_of::<bvh::GpuBvhNode>() + self.prim_refs.len() * 4
+    }
+}
+
+fn xform(t: &Option<TextureRef>) -> ([f32; 4], [f32; 4], u32) {
+    match t {
+        Some(r) => {
+            let m = r.transform;
+            ([m[0][0], m[0][1], m[0][2], 0.0], [m[1][0], m[1][1], m[1][2], 0.0], r.texture)
+        }
+        None => ([1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], INVALID),
+    }
+}
+
+fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
+    let (b0, b1, bt) = xform(&m.base_color_texture);
+    let (m0, m1, mt) = xform(&m.metallic_roughness_texture);
+    let (e0, e1, et) = xform(&m.emissive_texture);
+    let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
+    GpuMaterial {
+        base_color: m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0)),
+        metallic: finite(m.metallic, 0.0).clamp(0.0, 1.0),
+        emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
+        alpha: m.alpha(),
+        specular: finite(m.specular, 1.0).clamp(0.0, 1.0),
+        base_tex: bt,
+        mr_tex: mt,
+        emissive_tex: et,
+        base_xform0: b0,
+        base_xform1: b1,
+        mr_xform0: m0,
+        mr_xform1: m1,
+        em_xform0: e0,
+        em_xform1: e1,
+    }
+}
+
+fn wrap_tag(w: Wrap) -> u32 {
+    match w {
+        Wrap::Repeat => WRAP_REPEAT,
+        Wrap::Clamp => WRAP_CLAMP,
+        Wrap::Mirror => WRAP_MIRROR,
+    }
+}
+
+fn build_textures(scene: &Scene, d: &mut SceneData) {
+    for t in &scene.textures {
+        d.tex_info.push(GpuTextureInfo {
+            offset: d.tex_texels.len() as u32,
+            width: t.width,
+            height: t.height,
+            wrap_s: wrap_tag(t.wrap_s),
+            wrap_t: wrap_tag(t.wrap_t),
+            srgb: t.srgb as u32,
+            nearest: t.nearest as u32,
+            _pad0: 0,
+        });
+        d.tex_texels.extend(t.texels.iter().map(|c| u32::from_le_bytes(*c)));
+    }
+}
+
+/// Radius of a sphere bounding every finite primitive (for the power of distant lights).
+fn scene_radius(d: &SceneData) -> f64 {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    let mut add = |p: Vec3, r: f32| {
+        if p.is_finite() {
+            lo = lo.min(p - r);
+            hi = hi.max(p + r);
+        }
+    };
+    for v in &d.tri_verts {
+        add(Vec3::new(v[0], v[1], v[2]), 0.0);
+    }
+    for s in &d.spheres {
+        add(Vec3::from(s.center), s.radius);
+    }
+    for q in &d.quads {
+        let c = Vec3::from(q.corner);
+        add(c, 0.0);
+        add(c + Vec3::from(q.edge_u) + Vec3::from(q.edge_v), 0.0);
+    }
+    if lo.x > hi.x {
+        return 1.0;
+    }
+    (0.5 * (hi - lo).length() as f64).max(1e-3)
+}
+
+fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
+    let mut lights: Vec<GpuLight> = Vec::new();
+    let mut power: Vec<f64> = Vec::new();
+    let emits = |m: u32| {
+        let gm = &d.materials[m as usize];
+        gm.emission.iter().any(|&c| c > 0.0)
+    };
+    for (i, t) in tris.iter().enumerate() {
+        let m = d.tri_shading[i].material;
+        if !emits(m) {
+            continue;
+        }
+        let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        if !(area > 0.0 && area.is_finite()) {
+            continue;
+        }
+        d.tri_shading[i].light = lights.len() as u32;
+        power.push(PI * area as f64 * luminance(d.materials[m as usize].emission));
+        lights.push(GpuLight { kind: LIGHT_TRIANGLE, prim: i as u32, area, ..Default::default() });
+    }
+    for i in 0..d.spheres.len() {
+        let s = d.spheres[i];
+        if !emits(s.material) || !(s.radius > 0.0) {
+            continue;
+        }
+        let area = 4.0 * std::f32::consts::PI * s.radius * s.radius;
+        d.spheres[i].light = lights.len() as u32;
+        power.push(PI * area as f64 * luminance(d.materials[s.material as usize].emission));
+        lights.push(GpuLight { kind: LIGHT_SPHERE, prim: i as u32, area, position: s.center, ..Default::default() });
+    }
+    for i in 0..d.quads.len() {
+        let q = d.quads[i];
+        let area = Vec3::from(q.edge_u).cross(Vec3::from(q.edge_v)).length();
+        if !emits(q.material) || !(area > 0.0 && area.is_finite()) {
+            continue;
+        }
+        d.quads[i].light = lights.len() as u32;
+        power.push(PI * area as f64 * luminance(d.materials[q.material as usize].emission));
+        lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, ..Default::default() });
+    }
+    let r = scene_radius(d);
+    for l in &scene.punctual_lights {
+        let (g, p) = match *l {
+            PunctualLight::Point { position, intensity } => (
+                GpuLight { kind: LIGHT_POINT, position: position.into(), radiance: intensity.into(), ..Default::default() },
+                4.0 * PI * luminance(intensity.into()),
+            ),
+            PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } => {
+                let (ci, co) = (inner_cone.cos(), outer_cone.cos());
+                let g = GpuLight {
+                    kind: LIGHT_SPOT,
+                    position: position.into(),
+                    direction: direction.normalize_or(Vec3::NEG_Z).into(),
+                    radiance: intensity.into(),
+                    cos_inner: ci.max(co + 1e-6).min(1.0),
+                    cos_outer: co,
+                    ..Default::default()
+                };
+                (g, 2.0 * PI * (1.0 - 0.5 * (ci + co) as f64) * luminance(intensity.into()))
+            }
+            PunctualLight::Directional { direction, irradiance } => (
+                GpuLight { kind: LIGHT_DIRECTIONAL, direction: direction.normalize_or(Vec3::NEG_Y).into(), radiance: irradiance.into(), ..Default::default() },
+                PI * r * r * luminance(irradiance.into()),
+            ),
+        };
+        d.delta_lights += 1;
+        power.push(p);
+        lights.push(g);
+    }
+    match &scene.environment {
+        Environment::None => {}
+        Environment::Constant(c) => {
+            d.env_constant = (*c).into();
+            d.env_scale = 1.0;
+            if c.max_element() > 0.0 {
+                d.env_light = Some(lights.len() as u32);
+                power.push(4.0 * PI * PI * r * r * luminance((*c).into()));
+                lights.push(GpuLight { kind: LIGHT_ENVIRONMENT, ..Default::default() });
+            }
+        }
+        Environment::Map { map, scale, rotation } => {
+            let dist = lights::env_distribution(map);
+            d.env_size = (map.width, map.height);
+            d.env_scale = *scale;
+            d.env_rotation = *rotation;
+            if dist.mean_luminance * (*scale as f64) > 0.0 {
+                d.env_light = Some(lights.len() as u32);
+                power.push(4.0 * PI * PI * r * r * dist.mean_luminance * *scale as f64);
+                lights.push(GpuLight { kind: LIGHT_ENVIRONMENT, ..Default::default() });
+            }
+            d.env_texels = dist.texels;
+            d.env_alias = dist.alias;
+        }
+    }
+    let table = lights::alias_table(&power);
+    let n = lights.len();
+    for (l, p) in lights.iter_mut().zip(&table.pmf) {
+        l.pmf_power = *p as f32;
+        l.pmf_uniform = 1.0 / n as f32;
+    }
+    d.lights = lights;
+    d.light_alias = table.entries;
+}
+
+/// The scene's buffers on a device, bound as group 0 of the render pipeline.
+pub struct GpuScene {
+    /// The CPU copy (statistics, light counts, environment parameters).
+    pub data: SceneData,
+    /// Group-0 buffers in binding order 0..=12.
+    pub buffers: Vec<wgpu::Buffer>,
+}
+
+/// Names of the group-0 bindings, in order (for messages about device limits).
+pub const BINDING_NAMES: [&str; 13] = [
+    "BVH nodes", "primitive references", "triangle vertices", "spheres", "quads", "triangle shading data", "materials",
+    "lights", "light alias table", "texture table", "texels", "environment texels", "environment alias table",
+];
+
+impl GpuScene {
+    /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
+    /// larger than the device's storage-buffer binding limit.
+    pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, String> {
+        let sizes = [
+            data.bvh_nodes.len() * 64,
+            data.prim_refs.len() * 4,
+            data.tri_verts.len() * 16,
+            data.spheres.len() * 32,
+            data.quads.len() * 48,
+            data.tri_shading.len() * 80,
+            data.materials.len() * 144,
+            data.lights.len() * 64,
+            data.light_alias.len() * 8,
+            data.tex_info.len() * 32,
+            data.tex_texels.len() * 4,
+            data.env_texels.len() * 16,
+            data.env_alias.len() * 8,
+        ];
+        let limit = ctx.max_storage_binding();
+        for (name, size) in BINDING_NAMES.iter().zip(sizes) {
+            if size as u64 > limit {
+                return Err(format!(
+                    "the scene is too large for this device: its {name} need {} MiB, but the device's max_storage_buffer_binding_size is {} MiB",
+                    size >> 20,
+                    limit >> 20
+                ));
+            }
+        }
+        let u = wgpu::BufferUsages::empty();
+        let buffers = vec![
+            ctx.storage_buffer("bvh_nodes", &data.bvh_nodes, u),
+            ctx.storage_buffer("prim_refs", &data.prim_refs, u),
+            ctx.storage_buffer("tri_verts", &data.tri_verts, u),
+            ctx.storage_buffer("spheres", &data.spheres, u),
+            ctx.storage_buffer("quads", &data.quads, u),
+            ctx.storage_buffer("tri_shading", &data.tri_shading, u),
+            ctx.storage_buffer("materials", &data.materials, u),
+            ctx.storage_buffer("lights", &data.lights, u),
+            ctx.storage_buffer("light_alias", &data.light_alias, u),
+            ctx.storage_buffer("tex_info", &data.tex_info, u),
+            ctx.storage_buffer("tex_texels", &data.tex_texels, u),
+            ctx.storage_buffer("env_texels", &data.env_texels, u),
+            ctx.storage_buffer("env_alias", &data.env_alias, u),
+        ];
+        Ok(GpuScene { data, buffers })
+    }
+}

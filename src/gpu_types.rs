@@ -1,0 +1,192 @@
+//! Structs shared with WGSL (`shaders/common.wgsl`), byte for byte. `tests/layout.rs` asks naga for the
+//! WGSL layout of each and compares it with `size_of` / `offset_of!`.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Marks "no index" in every u32 index field (texture slots, light of a primitive, ...).
+pub const INVALID: u32 = u32::MAX;
+
+/// Primitive kinds stored in the top two bits of a BVH primitive reference.
+pub const PRIM_TRIANGLE: u32 = 0;
+pub const PRIM_SPHERE: u32 = 1;
+pub const PRIM_QUAD: u32 = 2;
+pub const PRIM_KIND_SHIFT: u32 = 30;
+pub const PRIM_INDEX_MASK: u32 = (1 << PRIM_KIND_SHIFT) - 1;
+
+/// Packs a primitive kind and index into one reference (as WGSL `make_prim`).
+pub fn make_prim(kind: u32, index: u32) -> u32 {
+    debug_assert!(index <= PRIM_INDEX_MASK);
+    (kind << PRIM_KIND_SHIFT) | index
+}
+
+/// Light kinds (`Light::kind`).
+pub const LIGHT_TRIANGLE: u32 = 0;
+pub const LIGHT_SPHERE: u32 = 1;
+pub const LIGHT_QUAD: u32 = 2;
+pub const LIGHT_POINT: u32 = 3;
+pub const LIGHT_SPOT: u32 = 4;
+pub const LIGHT_DIRECTIONAL: u32 = 5;
+pub const LIGHT_ENVIRONMENT: u32 = 6;
+
+/// Texture wrap modes (`TextureInfo::wrap_s`/`wrap_t`).
+pub const WRAP_REPEAT: u32 = 0;
+pub const WRAP_CLAMP: u32 = 1;
+pub const WRAP_MIRROR: u32 = 2;
+
+/// An analytic sphere (WGSL `Sphere`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuSphere {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub material: u32,
+    pub light: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// An analytic parallelogram (WGSL `Quad`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuQuad {
+    pub corner: [f32; 3],
+    pub material: u32,
+    pub edge_u: [f32; 3],
+    pub light: u32,
+    pub edge_v: [f32; 3],
+    pub _pad0: u32,
+}
+
+/// Per-triangle shading data (WGSL `TriShading`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuTriShading {
+    pub n0: [f32; 3],
+    pub material: u32,
+    pub n1: [f32; 3],
+    pub light: u32,
+    pub n2: [f32; 3],
+    pub _pad0: u32,
+    pub uv0: [f32; 2],
+    pub uv1: [f32; 2],
+    pub uv2: [f32; 2],
+    pub _pad1: [u32; 2],
+}
+
+/// A material (WGSL `Material`); see the WGSL comment for the meaning of each field.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub base_color: [f32; 3],
+    pub metallic: f32,
+    pub emission: [f32; 3],
+    pub alpha: f32,
+    pub specular: f32,
+    pub base_tex: u32,
+    pub mr_tex: u32,
+    pub emissive_tex: u32,
+    pub base_xform0: [f32; 4],
+    pub base_xform1: [f32; 4],
+    pub mr_xform0: [f32; 4],
+    pub mr_xform1: [f32; 4],
+    pub em_xform0: [f32; 4],
+    pub em_xform1: [f32; 4],
+}
+
+/// One entry of the light table (WGSL `Light`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub kind: u32,
+    pub direction: [f32; 3],
+    pub prim: u32,
+    pub radiance: [f32; 3],
+    pub pmf_power: f32,
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+    pub area: f32,
+    pub pmf_uniform: f32,
+}
+
+/// Alias-table entry (WGSL `AliasEntry`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuAliasEntry {
+    pub prob: f32,
+    pub alias_index: u32,
+}
+
+/// Where a texture lives in the texel buffer and how it is read (WGSL `TextureInfo`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuTextureInfo {
+    pub offset: u32,
+    pub width: u32,
+    pub height: u32,
+    pub wrap_s: u32,
+    pub wrap_t: u32,
+    pub srgb: u32,
+    pub nearest: u32,
+    pub _pad0: u32,
+}
+
+/// Per-pixel accumulator (WGSL `Accum`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuAccum {
+    pub mean: [f32; 3],
+    pub count: u32,
+    pub m2: [f32; 3],
+    pub nonfinite: u32,
+}
+
+/// Per-dispatch parameters (WGSL `FrameParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuFrameParams {
+    pub width: u32,
+    pub height: u32,
+    pub sample_base: u32,
+    pub samples_per_dispatch: u32,
+    pub seed: u32,
+    pub mode: u32,
+    pub max_depth: u32,
+    pub strategy: u32,
+    pub light_sampling: u32,
+    pub env_sampling: u32,
+    pub light_select: u32,
+    pub heuristic: u32,
+    pub power_beta: f32,
+    pub light_samples: u32,
+    pub bsdf_samples: u32,
+    pub mis_kind: u32,
+    pub sampler: u32,
+    pub num_lights: u32,
+    pub rr_depth: u32,
+    pub env_light: u32,
+    pub cam_origin: [f32; 3],
+    pub tan_half_fov: f32,
+    pub cam_right: [f32; 3],
+    pub aspect: f32,
+    pub cam_up: [f32; 3],
+    pub env_scale: f32,
+    pub cam_forward: [f32; 3],
+    pub env_rotation: f32,
+    pub env_constant: [f32; 3],
+    pub env_width: u32,
+    pub env_height: u32,
+    pub sampler_spp: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// A closest-hit result (WGSL `Hit`), used by probe kernels.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuHit {
+    pub t: f32,
+    pub prim: u32,
+    pub b1: f32,
+    pub b2: f32,
+}

@@ -1,0 +1,355 @@
+//! The `mislab` command line: render, info (and the subcommands later issues add).
+
+use clap::{Args, Parser, Subcommand};
+use mislab::film::Tonemap;
+use mislab::gpu::{self, GpuContext};
+use mislab::gpu_scene::{GpuScene, SceneData};
+use mislab::progressive::{self, Budget};
+use mislab::render::Renderer;
+use mislab::scene::{self, Environment, LoadOptions};
+use mislab::settings::*;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Exit code for bad input, a missing GPU, or a scene the device cannot hold.
+const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code after Ctrl-C (the partial image is still written).
+const EXIT_INTERRUPTED: u8 = 130;
+
+#[derive(Parser)]
+#[command(name = "mislab", version, about = "A GPU Monte Carlo renderer for seeing, measuring and trusting sampling strategies")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene progressively to PNG (tonemapped) or EXR (linear radiance).
+    Render(RenderArgs),
+    /// Print the Vulkan adapters, the chosen one and its limits; with a scene, its statistics.
+    Info {
+        /// A scene file or built-in name.
+        scene: Option<String>,
+    },
+}
+
+/// Estimator settings, the same names as the viewer panel and benchmark files.
+#[derive(Args, Clone)]
+struct SettingsArgs {
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512)]
+    height: u32,
+    /// Seed of every random number.
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// direct = emission seen by the camera + direct light at the first hit; path = path tracing.
+    #[arg(long, value_enum, default_value_t = Mode::Direct)]
+    mode: Mode,
+    /// Maximum path length in bounces (path mode).
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    /// Estimator: uniform, cosine, bsdf, light or mis.
+    #[arg(long, value_enum, default_value_t = Strategy::Mis)]
+    strategy: Strategy,
+    /// Area-light sampling: area or solid-angle.
+    #[arg(long, value_enum, default_value_t = LightSampling::SolidAngle)]
+    light_sampling: LightSampling,
+    /// Environment sampling: uniform or importance.
+    #[arg(long, value_enum, default_value_t = EnvSampling::Importance)]
+    env_sampling: EnvSampling,
+    /// Light selection: uniform or power.
+    #[arg(long, value_enum, default_value_t = LightSelect::Power)]
+    light_select: LightSelect,
+    /// MIS heuristic: balance or power.
+    #[arg(long, value_enum, default_value_t = Heuristic::Power)]
+    heuristic: Heuristic,
+    /// Exponent β of the power heuristic.
+    #[arg(long, default_value_t = 2.0)]
+    power_beta: f32,
+    /// MIS flavour: multi (fixed counts per technique) or one (one-sample MIS).
+    #[arg(long = "mis", value_enum, default_value_t = MisKind::Multi)]
+    mis_kind: MisKind,
+    /// Light samples per shading point.
+    #[arg(long, default_value_t = 1)]
+    light_samples: u32,
+    /// BSDF (direction) samples per shading point.
+    #[arg(long, default_value_t = 1)]
+    bsdf_samples: u32,
+    /// Sample sequence.
+    #[arg(long, value_enum, default_value_t = SamplerKind::Independent)]
+    sampler: SamplerKind,
+    /// Exposure in stops (PNG output).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f32,
+}
+
+impl SettingsArgs {
+    fn settings(&self) -> Settings {
+        Settings {
+            width: self.width,
+            height: self.height,
+            mode: self.mode,
+            strategy: self.strategy,
+            light_sampling: self.light_sampling,
+            env_sampling: self.env_sampling,
+            light_select: self.light_select,
+            heuristic: self.heuristic,
+            power_beta: self.power_beta,
+            mis: self.mis_kind,
+            light_samples: self.light_samples,
+            bsdf_samples: self.bsdf_samples,
+            sampler: self.sampler,
+            max_depth: self.max_depth,
+            seed: self.seed,
+            exposure: self.exposure,
+        }
+    }
+}
+
+/// How the scene is chosen and modified.
+#[derive(Args, Clone)]
+struct SceneArgs {
+    /// A .gltf/.glb/.toml file or a built-in scene: veach-mis, cornell-box, furnace, area-vs-cosine.
+    #[arg(default_value = "veach-mis")]
+    scene: String,
+    /// glTF scene index (default: the file's default scene).
+    #[arg(long)]
+    gltf_scene: Option<usize>,
+    /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Scale of the --env map.
+    #[arg(long, default_value_t = 1.0)]
+    env_scale: f32,
+    /// Rotation of the --env map about +Y, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    env_rotation: f32,
+}
+
+#[derive(Args, Clone)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output file; .png (sRGB, tonemapped) or .exr (linear float32 RGB).
+    #[arg(short, long, default_value = "render.png")]
+    output: PathBuf,
+    /// Samples per pixel.
+    #[arg(long, conflicts_with = "time")]
+    spp: Option<u32>,
+    /// Render for this many seconds (after start-up and shader compilation).
+    #[arg(long)]
+    time: Option<f64>,
+    /// Tonemapper for PNG output.
+    #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
+    tonemap: Tonemap,
+    #[command(flatten)]
+    settings: SettingsArgs,
+}
+
+impl Default for RenderArgs {
+    fn default() -> Self {
+        RenderArgs::parse_from_default()
+    }
+}
+
+impl RenderArgs {
+    fn parse_from_default() -> Self {
+        #[derive(Parser)]
+        struct Wrapper {
+            #[command(flatten)]
+            args: RenderArgs,
+        }
+        Wrapper::parse_from(["mislab"]).args
+    }
+}
+
+/// An error with the exit code it should produce.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+fn bad(message: impl Into<String>) -> Failure {
+    Failure { code: EXIT_BAD_INPUT, message: message.into() }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command.unwrap_or(Command::Render(RenderArgs::default())) {
+        Command::Render(args) => render(args),
+        Command::Info { scene } => info(scene),
+    };
+    match result {
+        Ok(code) => ExitCode::from(code),
+        Err(f) => {
+            eprintln!("error: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+fn gpu_context() -> Result<GpuContext, Failure> {
+    GpuContext::new().map_err(|e| bad(e.to_string()))
+}
+
+/// Loads the scene named on the command line, applies --env, prints its warnings once.
+fn load_scene(args: &SceneArgs) -> Result<scene::Scene, Failure> {
+    // Loader panics are caught in scene::load; keep the default hook from printing them as crashes.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let loaded = scene::load(&args.scene, &LoadOptions { gltf_scene: args.gltf_scene });
+    std::panic::set_hook(hook);
+    let mut scene = loaded.map_err(|e| bad(e.to_string()))?;
+    if let Some(env) = &args.env {
+        let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| bad(e.to_string()))?;
+        scene.warnings.extend(warnings);
+        scene.environment = Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
+    }
+    if !scene.has_lights() {
+        scene.warnings.push("the scene has no lights and no environment: the image will be black".into());
+    }
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", args.scene);
+    }
+    Ok(scene)
+}
+
+/// Lights a strategy can never reach (delta lights under direction-only strategies): say so once.
+fn unreachable_light_warning(data: &SceneData, s: &Settings) -> Option<String> {
+    let direction_only = matches!(s.strategy, Strategy::Uniform | Strategy::Cosine | Strategy::Bsdf);
+    (direction_only && data.delta_lights > 0).then(|| {
+        format!(
+            "--strategy {} cannot reach the scene's {} point/spot/directional light(s) (they are delta distributions that only light sampling finds); their light is missing from this image",
+            s.strategy, data.delta_lights
+        )
+    })
+}
+
+fn render(args: RenderArgs) -> Result<u8, Failure> {
+    let settings = args.settings.settings();
+    settings.validate().map_err(bad)?;
+    let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    if !matches!(ext.as_deref(), Some("png") | Some("exr")) {
+        return Err(bad(format!("{}: unknown output format (use .png or .exr)", args.output.display())));
+    }
+    let budget = match (args.spp, args.time) {
+        (Some(0), _) => return Err(bad("--spp must be at least 1")),
+        (Some(n), _) => Budget::Samples(n),
+        (None, Some(t)) if t.is_finite() && t > 0.0 => Budget::Time(Duration::from_secs_f64(t)),
+        (None, Some(t)) => return Err(bad(format!("--time {t} must be a positive number of seconds"))),
+        (None, None) => Budget::Samples(64),
+    };
+    let t_start = Instant::now();
+    let ctx = gpu_context()?;
+    eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
+    let t_device = Instant::now();
+    let scene = load_scene(&args.scene)?;
+    let t_loaded = Instant::now();
+    let data = SceneData::build(&scene);
+    eprintln!(
+        "scene: {} — {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights; BVH {} nodes built in {:.1} ms, {:.1} MiB ({:.0} B/triangle)",
+        scene.name,
+        scene.triangle_count(),
+        scene.spheres.len(),
+        scene.quads.len(),
+        scene.materials.len(),
+        scene.textures.len(),
+        data.lights.len(),
+        data.bvh_nodes.len(),
+        data.bvh_seconds * 1e3,
+        data.bvh_bytes() as f64 / (1 << 20) as f64,
+        data.bvh_bytes() as f64 / scene.triangle_count().max(1) as f64,
+    );
+    if let Some(w) = unreachable_light_warning(&data, &settings) {
+        eprintln!("warning: {w}");
+    }
+    let gpu_scene = GpuScene::upload(&ctx, data).map_err(|e| bad(format!("{}: {e}", args.scene.scene)))?;
+    let mut renderer = Renderer::new(&ctx, &gpu_scene, scene.camera.clone(), settings.clone()).map_err(bad)?;
+    ctx.wait().map_err(|e| bad(e.to_string()))?;
+    let t_ready = Instant::now();
+    eprintln!(
+        "start-up: {:.2} s (device {:.2} s, scene load {:.2} s, BVH + upload + shader compilation {:.2} s) — not counted in the render time",
+        (t_ready - t_start).as_secs_f64(),
+        (t_device - t_start).as_secs_f64(),
+        (t_loaded - t_device).as_secs_f64(),
+        (t_ready - t_loaded).as_secs_f64()
+    );
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let bar = match budget {
+        Budget::Samples(n) => indicatif::ProgressBar::new(n as u64),
+        Budget::Time(t) => indicatif::ProgressBar::new((t.as_secs_f64() * 1000.0) as u64),
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let pixels = (settings.width * settings.height) as f64;
+    let stats = progressive::run(&ctx, &mut renderer, budget, &interrupt, |spp, secs| {
+        match budget {
+            Budget::Samples(_) => bar.set_position(spp as u64),
+            Budget::Time(_) => bar.set_position((secs * 1000.0) as u64),
+        }
+        bar.set_message(format!("{spp} spp, {:.2} M samples/s", spp as f64 * pixels / secs.max(1e-9) / 1e6));
+    })
+    .map_err(|e| bad(e.to_string()))?;
+    bar.finish_and_clear();
+    let film = renderer.film(&ctx).map_err(|e| bad(e.to_string()))?;
+    film.save(&args.output, settings.exposure, args.tonemap).map_err(bad)?;
+    eprintln!(
+        "{} spp in {:.2} s: {:.2} M samples/s, {:.2} Mrays/s, {} NaN/Inf samples",
+        stats.spp,
+        stats.seconds,
+        stats.spp as f64 * pixels / stats.seconds.max(1e-9) / 1e6,
+        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+        stats.nonfinite
+    );
+    if stats.interrupted {
+        eprintln!("interrupted: wrote the {} samples per pixel accumulated so far to {}", stats.spp, args.output.display());
+        return Ok(EXIT_INTERRUPTED);
+    }
+    eprintln!("wrote {}", args.output.display());
+    Ok(0)
+}
+
+fn info(scene_name: Option<String>) -> Result<u8, Failure> {
+    let adapters = gpu::list_adapters();
+    println!("Vulkan adapters:");
+    for a in &adapters {
+        println!("  {} ({:?}, {})", a.name, a.device_type, a.driver);
+    }
+    let ctx = gpu_context()?;
+    print!("chosen {}", gpu::describe(&ctx));
+    if let Some(name) = scene_name {
+        let args = SceneArgs { scene: name, gltf_scene: None, env: None, env_scale: 1.0, env_rotation: 0.0 };
+        let scene = load_scene(&args)?;
+        let data = SceneData::build(&scene);
+        println!(
+            "scene {}: {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights ({} delta), environment: {}",
+            scene.name,
+            scene.triangle_count(),
+            scene.spheres.len(),
+            scene.quads.len(),
+            scene.materials.len(),
+            scene.textures.len(),
+            data.lights.len(),
+            data.delta_lights,
+            match &scene.environment {
+                Environment::None => "none".to_string(),
+                Environment::Constant(c) => format!("constant {c}"),
+                Environment::Map { map, .. } => format!("map {} ({}x{})", map.path.display(), map.width, map.height),
+            }
+        );
+        println!("BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes", data.bvh_nodes.len(), data.bvh_seconds * 1e3, data.bvh_sah, data.bvh_bytes());
+    }
+    Ok(0)
+}

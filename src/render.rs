@@ -1,0 +1,252 @@
+//! Renderer: the render pipeline, per-render buffers (frame parameters, accumulation, counters),
+//! progressive dispatch, reset and readback.
+
+use crate::film::Film;
+use crate::gpu::{GpuContext, GpuError};
+use crate::gpu_scene::GpuScene;
+use crate::gpu_types::*;
+use crate::scene::Camera;
+use crate::settings::{Mode, Settings};
+use crate::shaders;
+
+/// WGSL files of the render entry point, in order.
+pub const RENDER_FILES: &[&str] = &[
+    "common.wgsl",
+    "geometry_bindings.wgsl",
+    "shading_bindings.wgsl",
+    "rng.wgsl",
+    "samplers.wgsl",
+    "warps.wgsl",
+    "bvh.wgsl",
+    "bsdf.wgsl",
+    "surface.wgsl",
+    "lights.wgsl",
+    "mis.wgsl",
+    "estimators.wgsl",
+    "integrator.wgsl",
+];
+
+/// Depth after which Russian roulette starts (the issue: "after depth 3").
+pub const RR_DEPTH: u32 = 3;
+
+/// The composed render module.
+pub fn render_source() -> String {
+    shaders::compose(RENDER_FILES, "")
+}
+
+/// A progressive renderer of one scene with one set of settings (change either → `reset`).
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipeline: wgpu::ComputePipeline,
+    scene_group: wgpu::BindGroup,
+    frame_group: wgpu::BindGroup,
+    params_buffer: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    /// Settings in force.
+    pub settings: Settings,
+    /// Camera in force.
+    pub camera: Camera,
+    /// Samples per pixel accumulated since the last reset.
+    pub samples: u32,
+    /// Non-finite samples since the last reset (device counter, summed on the host).
+    pub nonfinite_total: u64,
+    /// Rays traced since the last reset.
+    pub rays_total: u64,
+    env_light: u32,
+    env_size: (u32, u32),
+    env_constant: [f32; 3],
+    env_scale: f32,
+    env_rotation: f32,
+    num_lights: u32,
+}
+
+impl Renderer {
+    /// Builds the pipeline and the per-render buffers for `scene` at the settings' film size.
+    pub fn new(ctx: &GpuContext, scene: &GpuScene, camera: Camera, settings: Settings) -> Result<Renderer, String> {
+        settings.validate()?;
+        let device = ctx.device.clone();
+        let pipeline = shaders::compute_pipeline(&device, "render", &render_source(), "render_main", &[])?;
+        let layout0 = pipeline.get_bind_group_layout(0);
+        let entries: Vec<wgpu::BindGroupEntry> = scene
+            .buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .collect();
+        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("scene"), layout: &layout0, entries: &entries });
+        let pixels = settings.width as u64 * settings.height as u64;
+        let accum_bytes = pixels * std::mem::size_of::<GpuAccum>() as u64;
+        if accum_bytes > ctx.max_storage_binding() {
+            return Err(format!(
+                "a {}x{} film needs {} MiB of accumulation buffer, more than the device's storage-binding limit of {} MiB",
+                settings.width,
+                settings.height,
+                accum_bytes >> 20,
+                ctx.max_storage_binding() >> 20
+            ));
+        }
+        let accum = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accum"),
+            size: accum_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let counters = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("counters"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<GpuFrameParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &pipeline.get_bind_group_layout(1),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: accum.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: counters.as_entire_binding() },
+            ],
+        });
+        let d = &scene.data;
+        let mut r = Renderer {
+            device,
+            queue: ctx.queue.clone(),
+            pipeline,
+            scene_group,
+            frame_group,
+            params_buffer,
+            accum,
+            counters,
+            settings,
+            camera,
+            samples: 0,
+            nonfinite_total: 0,
+            rays_total: 0,
+            env_light: d.env_light.unwrap_or(INVALID),
+            env_size: d.env_size,
+            env_constant: d.env_constant,
+            env_scale: d.env_scale,
+            env_rotation: d.env_rotation,
+            num_lights: d.lights.len() as u32,
+        };
+        r.reset();
+        Ok(r)
+    }
+
+    /// Forgets every accumulated sample (the next dispatch starts from sample 0).
+    pub fn reset(&mut self) {
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.accum, 0, None);
+        enc.clear_buffer(&self.counters, 0, None);
+        self.queue.submit([enc.finish()]);
+        self.samples = 0;
+        self.nonfinite_total = 0;
+        self.rays_total = 0;
+    }
+
+    /// Changes settings (film size excluded) and resets.
+    pub fn set_settings(&mut self, settings: Settings) -> Result<(), String> {
+        settings.validate()?;
+        if settings.width != self.settings.width || settings.height != self.settings.height {
+            return Err("the film size cannot change on an existing renderer".into());
+        }
+        self.settings = settings;
+        self.reset();
+        Ok(())
+    }
+
+    /// The frame parameters of a dispatch of `spp` samples starting at the current sample count.
+    pub fn frame_params(&self, spp: u32) -> GpuFrameParams {
+        let s = &self.settings;
+        let (right, up, forward) = self.camera.frame();
+        GpuFrameParams {
+            width: s.width,
+            height: s.height,
+            sample_base: self.samples,
+            samples_per_dispatch: spp,
+            seed: s.seed,
+            mode: s.mode.tag(),
+            max_depth: if s.mode == Mode::Direct { 1 } else { s.max_depth },
+            strategy: s.strategy.tag(),
+            light_sampling: s.light_sampling.tag(),
+            env_sampling: s.env_sampling.tag(),
+            light_select: s.light_select.tag(),
+            heuristic: s.heuristic.tag(),
+            power_beta: s.power_beta,
+            light_samples: s.light_samples,
+            bsdf_samples: s.bsdf_samples,
+            mis_kind: s.mis.tag(),
+            sampler: s.sampler.tag(),
+            num_lights: self.num_lights,
+            rr_depth: RR_DEPTH,
+            env_light: self.env_light,
+            cam_origin: self.camera.position.into(),
+            tan_half_fov: (0.5 * self.camera.vfov).tan(),
+            cam_right: right.into(),
+            aspect: s.width as f32 / s.height as f32,
+            cam_up: up.into(),
+            env_scale: self.env_scale,
+            cam_forward: forward.into(),
+            env_rotation: self.env_rotation,
+            env_constant: self.env_constant,
+            env_width: self.env_size.0,
+            env_height: self.env_size.1,
+            sampler_spp: 0,
+            _pad0: 0,
+            _pad1: 0,
+        }
+    }
+
+    /// Records one dispatch of `spp` samples per pixel into `enc` and advances the sample count.
+    /// The parameters are written to the queue first, so call `submit` before recording another.
+    pub fn encode(&mut self, enc: &mut wgpu::CommandEncoder, spp: u32) {
+        let p = self.frame_params(spp);
+        self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.scene_group, &[]);
+        pass.set_bind_group(1, &self.frame_group, &[]);
+        pass.dispatch_workgroups(self.settings.width.div_ceil(8), self.settings.height.div_ceil(8), 1);
+        drop(pass);
+        self.samples += spp;
+    }
+
+    /// Renders `spp` more samples per pixel in one submission and waits for them (with the device timeout).
+    pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), GpuError> {
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        self.encode(&mut enc, spp);
+        self.queue.submit([enc.finish()]);
+        ctx.wait()?;
+        self.collect_counters(ctx)
+    }
+
+    /// Adds the device counters to the host totals and clears them (u32 on the device would overflow).
+    pub fn collect_counters(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        let c: Vec<u32> = ctx.read_pod(&self.counters, 4)?;
+        self.nonfinite_total += c[0] as u64;
+        self.rays_total += c[1] as u64;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.counters, 0, None);
+        self.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
+    /// Reads the accumulation back.
+    pub fn film(&self, ctx: &GpuContext) -> Result<Film, GpuError> {
+        let n = (self.settings.width * self.settings.height) as usize;
+        let accum: Vec<GpuAccum> = ctx.read_pod(&self.accum, n)?;
+        Ok(Film::from_accum(self.settings.width, self.settings.height, &accum, self.nonfinite_total))
+    }
+
+    /// The accumulation buffer (for the viewer's display pass).
+    pub fn accum_buffer(&self) -> &wgpu::Buffer {
+        &self.accum
+    }
+}

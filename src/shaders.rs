@@ -1,0 +1,72 @@
+//! WGSL composition: every shader file is embedded in the binary (the product never reads `shaders/` at
+//! run time); an entry point is an ordered list of files concatenated into one module.
+
+/// Every WGSL file, by name, embedded at compile time.
+pub const FILES: &[(&str, &str)] = &[
+    ("common.wgsl", include_str!("../shaders/common.wgsl")),
+    ("geometry_bindings.wgsl", include_str!("../shaders/geometry_bindings.wgsl")),
+    ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
+    ("shading_bindings.wgsl", include_str!("../shaders/shading_bindings.wgsl")),
+    ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
+    ("samplers.wgsl", include_str!("../shaders/samplers.wgsl")),
+    ("warps.wgsl", include_str!("../shaders/warps.wgsl")),
+    ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
+    ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
+    ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
+    ("mis.wgsl", include_str!("../shaders/mis.wgsl")),
+    ("estimators.wgsl", include_str!("../shaders/estimators.wgsl")),
+    ("integrator.wgsl", include_str!("../shaders/integrator.wgsl")),
+];
+
+/// The source of one embedded file.
+pub fn file(name: &str) -> &'static str {
+    FILES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .unwrap_or_else(|| panic!("no embedded shader file named {name}"))
+}
+
+/// Concatenates files (in order) and extra source into one module, with a marker line per file so
+/// naga's error positions can be traced back.
+pub fn compose(files: &[&str], extra: &str) -> String {
+    let mut out = String::new();
+    for f in files {
+        out += &format!("// ---- {f} ----\n");
+        out += file(f);
+        out += "\n";
+    }
+    out += extra;
+    out
+}
+
+/// Parses and validates a composed module with naga, returning the module or a readable error.
+pub fn validate(source: &str) -> Result<naga::Module, String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+    validator.validate(&module).map_err(|e| e.emit_to_string(source))?;
+    Ok(module)
+}
+
+/// Builds a compute pipeline from a composed module (validated by naga first so errors are readable).
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::ComputePipeline, String> {
+    validate(source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: false },
+        cache: None,
+    }))
+}

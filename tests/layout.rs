@@ -1,0 +1,106 @@
+//! Every struct shared between Rust and WGSL has the same size and member offsets on both sides (naga's
+//! own layout of the WGSL), and every WGSL tag constant equals its Rust enum discriminant. No GPU needed.
+
+use mislab::bvh::GpuBvhNode;
+use mislab::gpu_types::*;
+use mislab::settings::*;
+use std::mem::{offset_of, size_of};
+
+fn module() -> naga::Module {
+    let src = mislab::render::render_source();
+    mislab::shaders::validate(&src).unwrap_or_else(|e| panic!("render module does not validate:\n{e}"))
+}
+
+/// (size, [(member name, offset)]) of a WGSL struct by name.
+fn wgsl_layout(m: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
+    for (_, ty) in m.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                return (*span, members.iter().map(|mm| (mm.name.clone().unwrap_or_default(), mm.offset)).collect());
+            }
+        }
+    }
+    panic!("WGSL struct {name} not found (is it used by the render module?)");
+}
+
+macro_rules! check {
+    ($m:expr, $wgsl:literal, $rust:ty, [$($field:ident),+ $(,)?]) => {{
+        let (size, members) = wgsl_layout(&$m, $wgsl);
+        let rust: Vec<(&str, usize)> = vec![$((stringify!($field), offset_of!($rust, $field))),+];
+        assert_eq!(size as usize, size_of::<$rust>(), "size of {} (WGSL) vs {} (Rust)", $wgsl, stringify!($rust));
+        assert_eq!(members.len(), rust.len(), "{}: WGSL has members {:?}", $wgsl, members);
+        for ((wn, wo), (rn, ro)) in members.iter().zip(&rust) {
+            assert_eq!(wn, rn, "{}: member order/name differs", $wgsl);
+            assert_eq!(*wo as usize, *ro, "{}.{}: WGSL offset {} vs Rust {}", $wgsl, wn, wo, ro);
+        }
+    }};
+}
+
+#[test]
+fn shared_structs_match() {
+    let m = module();
+    check!(m, "Sphere", GpuSphere, [center, radius, material, light, _pad0, _pad1]);
+    check!(m, "Quad", GpuQuad, [corner, material, edge_u, light, edge_v, _pad0]);
+    check!(m, "TriShading", GpuTriShading, [n0, material, n1, light, n2, _pad0, uv0, uv1, uv2, _pad1]);
+    check!(m, "Material", GpuMaterial, [base_color, metallic, emission, alpha, specular, base_tex, mr_tex, emissive_tex,
+        base_xform0, base_xform1, mr_xform0, mr_xform1, em_xform0, em_xform1]);
+    check!(m, "Light", GpuLight, [position, kind, direction, prim, radiance, pmf_power, cos_inner, cos_outer, area, pmf_uniform]);
+    check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
+    check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, _pad0]);
+    check!(m, "Accum", GpuAccum, [mean, count, m2, nonfinite]);
+    check!(m, "FrameParams", GpuFrameParams, [width, height, sample_base, samples_per_dispatch, seed, mode, max_depth,
+        strategy, light_sampling, env_sampling, light_select, heuristic, power_beta, light_samples, bsdf_samples,
+        mis_kind, sampler, num_lights, rr_depth, env_light, cam_origin, tan_half_fov, cam_right, aspect, cam_up,
+        env_scale, cam_forward, env_rotation, env_constant, env_width, env_height, sampler_spp, _pad0, _pad1]);
+    check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
+    check!(m, "BvhNode", GpuBvhNode, [lmin, l_first, lmax, l_count, rmin, r_first, rmax, r_count]);
+}
+
+/// The value of a WGSL `const NAME: u32`.
+fn wgsl_const(m: &naga::Module, name: &str) -> u32 {
+    for (_, c) in m.constants.iter() {
+        if c.name.as_deref() == Some(name) {
+            if let naga::Expression::Literal(naga::Literal::U32(v)) = m.global_expressions[c.init] {
+                return v;
+            }
+            panic!("WGSL constant {name} is not a u32 literal");
+        }
+    }
+    panic!("WGSL constant {name} not found");
+}
+
+fn wgsl_name(prefix: &str, text: &str) -> String {
+    format!("{prefix}{}", text.to_uppercase().replace('-', "_"))
+}
+
+macro_rules! check_enum {
+    ($m:expr, $ty:ty) => {
+        for v in <$ty>::ALL {
+            let name = wgsl_name(<$ty>::WGSL_PREFIX, v.name());
+            assert_eq!(wgsl_const(&$m, &name), v.tag(), "{name} differs between WGSL and Rust");
+        }
+    };
+}
+
+#[test]
+fn tag_constants_match() {
+    let m = module();
+    check_enum!(m, Mode);
+    check_enum!(m, Strategy);
+    check_enum!(m, LightSampling);
+    check_enum!(m, EnvSampling);
+    check_enum!(m, LightSelect);
+    check_enum!(m, Heuristic);
+    check_enum!(m, MisKind);
+    check_enum!(m, SamplerKind);
+    for (name, v) in [
+        ("PRIM_TRIANGLE", PRIM_TRIANGLE), ("PRIM_SPHERE", PRIM_SPHERE), ("PRIM_QUAD", PRIM_QUAD),
+        ("PRIM_KIND_SHIFT", PRIM_KIND_SHIFT), ("PRIM_INDEX_MASK", PRIM_INDEX_MASK),
+        ("LIGHT_TRIANGLE", LIGHT_TRIANGLE), ("LIGHT_SPHERE", LIGHT_SPHERE), ("LIGHT_QUAD", LIGHT_QUAD),
+        ("LIGHT_POINT", LIGHT_POINT), ("LIGHT_SPOT", LIGHT_SPOT), ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
+        ("LIGHT_ENVIRONMENT", LIGHT_ENVIRONMENT), ("WRAP_REPEAT", WRAP_REPEAT), ("WRAP_CLAMP", WRAP_CLAMP),
+        ("WRAP_MIRROR", WRAP_MIRROR), ("INVALID", INVALID),
+    ] {
+        assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");
+    }
+}
