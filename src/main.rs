@@ -65,7 +65,7 @@ struct SettingsArgs {
     #[arg(long, value_enum, default_value_t = EnvSampling::Importance)]
     env_sampling: EnvSampling,
     /// Light selection: uniform or power.
-    #[arg(long, value_enum, default_value_t = LightSelect::Power)]
+    #[arg(long, value_enum, default_value_t = LightSelect::Uniform)]
     light_select: LightSelect,
     /// MIS heuristic: balance or power.
     #[arg(long, value_enum, default_value_t = Heuristic::Power)]

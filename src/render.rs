@@ -137,7 +137,19 @@ impl Renderer {
             num_lights: d.lights.len() as u32,
         };
         r.reset();
+        r.warm_up(ctx).map_err(|e| e.to_string())?;
         Ok(r)
+    }
+
+    /// Runs a zero-sample dispatch: drivers such as lavapipe compile the pipeline at its first use
+    /// (seconds for the render kernel), and that belongs to start-up, not to the render time.
+    pub fn warm_up(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        let samples = self.samples;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        self.encode(&mut enc, 0);
+        self.queue.submit([enc.finish()]);
+        self.samples = samples;
+        ctx.wait()
     }
 
     /// Forgets every accumulated sample (the next dispatch starts from sample 0).

@@ -179,7 +179,7 @@ impl Default for Settings {
             strategy: Strategy::Mis,
             light_sampling: LightSampling::SolidAngle,
             env_sampling: EnvSampling::Importance,
-            light_select: LightSelect::Power,
+            light_select: LightSelect::Uniform,
             heuristic: Heuristic::Power,
             power_beta: 2.0,
             mis: MisKind::Multi,

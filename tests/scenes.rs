@@ -197,13 +197,18 @@ fn area_vs_cosine_shows_both_regions() {
         let d = p - c.position;
         (d.dot(r) / d.dot(f) / t, d.dot(u) / d.dot(f) / t)
     };
-    let near_light = quad_center(light) + Vec3::new(0.0, -height, 2.5); // floor just in front of the light
+    let (x, y) = film(quad_center(light));
+    assert!((-1.0..-0.2).contains(&x) && y.abs() < 1.0, "light centre at film ({x}, {y})");
+    let near_light = Vec3::new(-2.0, 0.0, 2.5); // floor just in front of the light's near edge
     let (x, y) = film(near_light);
     assert!((-1.0..-0.2).contains(&x) && y.abs() < 1.0, "near-light floor at film ({x}, {y})");
-    let far = Vec3::new(9.0, 0.0, -1.0);
-    let (x, y) = film(far);
-    assert!((0.2..1.0).contains(&x) && y.abs() < 1.0, "far floor at film ({x}, {y})");
-    assert!((far - quad_center(light)).length() > 10.0 * height * 2.0);
+    // The floor on the right of the frame is several light-heights away from the light.
+    for (fx, fy) in [(0.7, 0.2), (0.7, -0.5)] {
+        let d = (f + r * fx * t + u * fy * t).normalize();
+        let p = c.position + d * (-c.position.y / d.y);
+        assert!(d.y < 0.0 && p.x.abs() < 10.0 && p.z.abs() < 10.0, "film ({fx}, {fy}) misses the floor");
+        assert!(p.x - (light.corner.x + light.edge_u.x) > 6.0 * height, "film ({fx}, {fy}) is floor at {p}, too near the light");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -594,15 +599,15 @@ fn env_map_sanitises_bad_texels() {
     assert!(w.contains("bad.exr") && w.contains("repaired 5 of 8 texels"), "{w}");
     assert!(w.contains("1 NaN") && w.contains("2 infinite") && w.contains("1 negative") && w.contains("1 above 1e30"), "{w}");
 
-    // Radiance file with an exponent-255 texel, which the decoder turns into ~1.7e38: flat RGBE, 3×1.
-    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 3\n".to_vec();
-    hdr.extend_from_slice(&[128, 128, 128, 129, 255, 255, 255, 255, 0, 0, 0, 0]);
+    // Radiance file with an exponent-255 texel, which the decoder turns into ~1.7e38: flat RGBE, 2×1.
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
+    hdr.extend_from_slice(&[128, 128, 128, 129, 255, 255, 255, 255]);
     let path = dir.join("exp255.hdr");
     std::fs::write(&path, hdr).unwrap();
     let (map, warnings) = load_envmap(&path).unwrap();
-    assert_eq!(map.texels, vec![[1.0; 3], [0.0; 3], [0.0; 3]]);
+    assert_eq!(map.texels, vec![[1.0; 3], [0.0; 3]]);
     assert_eq!(warnings.len(), 1, "{warnings:?}");
-    assert!(warnings[0].contains("repaired 1 of 3") && warnings[0].contains("above 1e30"), "{}", warnings[0]);
+    assert!(warnings[0].contains("repaired 1 of 2") && warnings[0].contains("3 above 1e30"), "{}", warnings[0]);
 
     // Clean files give no warning.
     let clean = image::Rgb32FImage::from_raw(2, 1, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
@@ -682,3 +687,4 @@ fn shipped_sky_matches_its_recipe() {
         }
     }
 }
+

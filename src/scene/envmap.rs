@@ -101,16 +101,17 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
             kinds.push(format!("{inf} infinite"));
         }
         if negative > 0 {
-            kinds.push(format!("{negative} negative (down to {most_negative:.3e})"));
+            kinds.push(format!("{negative} negative, down to {most_negative:.3e}"));
         }
         if huge > 0 {
             kinds.push(format!("{huge} above 1e30"));
         }
         warnings.push(format!(
-            "{}: repaired {repaired} of {} texels by setting bad components to 0 ({} components)",
+            "{}: repaired {repaired} of {} texels ({} bad components set to 0: {})",
             path.display(),
             texels.len(),
-            kinds.join(", ")
+            nan + inf + negative + huge,
+            kinds.join("; ")
         ));
     }
     Ok((EnvMap { path: path.to_path_buf(), width, height, texels }, warnings))

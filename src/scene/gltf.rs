@@ -1064,7 +1064,10 @@ fn wrap(mode: Checked<json::texture::WrappingMode>) -> Wrap {
     }
 }
 
-/// `KHR_texture_transform` as the 2×3 matrix T·R·S of the extension (rotation counter-clockwise in UV).
+/// `KHR_texture_transform` as the 2×3 matrix T·R·S of the extension. R maps (u, v) to
+/// (u·cos + v·sin, −u·sin + v·cos): the sense the extension's worked example (offset [0, 1], rotation π/2,
+/// scale 0.5 selects the lower-left quadrant) and the reference viewers use; its GLSL snippet, read as
+/// column-major, would give the opposite sense.
 fn texture_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 3]; 2] {
     let (s, c) = rotation.sin_cos();
     let [sx, sy] = scale;

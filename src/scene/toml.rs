@@ -25,7 +25,9 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     let ctx = Ctx { path, text: &text, dir: path.parent().unwrap_or(Path::new("")).to_path_buf() };
     let file: FileDef = ::toml::from_str(&text).map_err(|e| {
         let at = e.span().map(|s| ctx.position(s.start)).unwrap_or_default();
-        SceneError::new(path, format!("{at}{}", e.message().trim_end()))
+        // toml's messages can span lines ("invalid table header\nexpected `.`, `]`"); keep ours on one.
+        let message = e.message().trim_end().replace('\n', "; ");
+        SceneError::new(path, format!("{at}{message}"))
     })?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     build(&ctx, file, name, options)
@@ -553,7 +555,8 @@ fn include(ctx: &Ctx, i: usize, inc: &Spanned<IncludeDef>, options: &LoadOptions
     // Contain loader panics here too, so the message says which include broke.
     let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| super::gltf::load(&path, &options)))
         .map_err(|_| e("the glTF loader failed on this file (malformed?)"))?
-        .map_err(|err| e(&err.to_string()))?;
+        // The loader's error already names the glTF file.
+        .map_err(|err| ctx.err(inc, format!("[[include]] {}: {err}", i + 1)))?;
     let mut loaded = loaded;
     transform_scene(&mut loaded, matrix).map_err(|m| e(&m))?;
     merge(scene, loaded, d.use_camera.unwrap_or(false));

@@ -1,0 +1,64 @@
+//! Helpers shared by the GPU integration tests. A missing adapter is a test FAILURE with a clear message.
+#![allow(dead_code)]
+
+use mislab::film::Film;
+use mislab::gpu::GpuContext;
+use mislab::gpu_scene::{GpuScene, SceneData};
+use mislab::render::Renderer;
+use mislab::scene::{self, LoadOptions, Scene};
+use mislab::settings::Settings;
+
+/// The GPU context, or a panic that says how to get one.
+pub fn gpu() -> GpuContext {
+    GpuContext::new().unwrap_or_else(|e| {
+        panic!("GPU tests need a Vulkan adapter and found none ({e}). On Debian/Ubuntu without a GPU: apt-get install mesa-vulkan-drivers")
+    })
+}
+
+/// Loads a built-in scene or file.
+pub fn scene(name: &str) -> Scene {
+    scene::load(name, &LoadOptions::default()).unwrap_or_else(|e| panic!("loading {name}: {e}"))
+}
+
+/// Renders `spp` samples of `scene` with `settings` and reads the film back.
+pub fn render(ctx: &GpuContext, scene: &Scene, settings: &Settings, spp: u32) -> Film {
+    let gs = GpuScene::upload(ctx, SceneData::build(scene)).expect("upload");
+    let mut r = Renderer::new(ctx, &gs, scene.camera.clone(), settings.clone()).expect("renderer");
+    let mut left = spp;
+    while left > 0 {
+        let n = left.min(64);
+        r.render(ctx, n).expect("render");
+        left -= n;
+    }
+    r.film(ctx).expect("readback")
+}
+
+/// Small test settings.
+pub fn small(width: u32, height: u32) -> Settings {
+    Settings { width, height, ..Settings::default() }
+}
+
+/// Two-sided Šidák-corrected z threshold for `m` tests at family-wise level `alpha`.
+pub fn sidak_z(alpha: f64, m: usize) -> f64 {
+    let per_test = 1.0 - (1.0 - alpha).powf(1.0 / m as f64);
+    inverse_normal_cdf(1.0 - per_test / 2.0)
+}
+
+/// Acklam's rational approximation of the standard normal quantile (relative error < 1.2e-9).
+pub fn inverse_normal_cdf(p: f64) -> f64 {
+    let a = [-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02, 1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00];
+    let b = [-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02, 6.680131188771972e+01, -1.328068155288572e+01];
+    let c = [-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00, -2.549671010279440e+00, 4.374664141464968e+00, 2.938163982698783e+00];
+    let d = [7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00, 3.754408661907416e+00];
+    let pl = 0.02425;
+    if p < pl {
+        let q = (-2.0 * p.ln()).sqrt();
+        (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0)
+    } else if p <= 1.0 - pl {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q / (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0)
+    } else {
+        -inverse_normal_cdf(1.0 - p)
+    }
+}

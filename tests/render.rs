@@ -1,0 +1,71 @@
+//! Whole-render tests on the device: the furnace renders 1, renders are bit-for-bit repeatable, and
+//! the accumulation statistics are what the shader claims.
+
+mod common;
+use common::*;
+use mislab::settings::*;
+
+/// Furnace: a sphere of albedo 1 under a constant white sky reflects exactly 1 in every direction, so
+/// every pixel's expected value is 1 — in direct mode (one bounce, nothing occludes a convex sphere)
+/// and in path mode. Checked by the image mean within 3σ and per-pixel z-tests (Šidák over pixels).
+fn furnace_is_one(mode: Mode, strategy: Strategy) {
+    let ctx = gpu();
+    let scene = scene("furnace");
+    let settings = Settings { mode, strategy, max_depth: 16, ..small(32, 32) };
+    let film = render(&ctx, &scene, &settings, 256);
+    assert_eq!(film.nonfinite_total, 0, "NaN/Inf samples in the furnace");
+    let n = film.mean.len();
+    let z_max = sidak_z(0.01, n * 3);
+    let (mut sum, mut var_sum) = (0.0, 0.0);
+    for i in 0..n {
+        let var = film.variance_of_mean(i).expect("≥ 2 samples");
+        for c in 0..3 {
+            let x = film.mean[i][c] as f64;
+            sum += x;
+            var_sum += var[c];
+            // A zero-variance pixel must be exactly right (up to f32 rounding of the mean).
+            let sd = var[c].sqrt().max(1e-6);
+            let z = (x - 1.0) / sd;
+            assert!(z.abs() < z_max, "{mode:?}/{strategy:?}: pixel {i} channel {c} = {x} (z = {z:.2}, limit {z_max:.2})");
+        }
+    }
+    let mean = sum / (3 * n) as f64;
+    let sigma = var_sum.sqrt() / (3 * n) as f64;
+    assert!((mean - 1.0).abs() < 3.0 * sigma.max(1e-6), "{mode:?}/{strategy:?}: image mean {mean} vs 1 (σ = {sigma:e})");
+}
+
+#[test]
+fn furnace_direct_every_strategy() {
+    for s in Strategy::ALL {
+        furnace_is_one(Mode::Direct, *s);
+    }
+}
+
+#[test]
+fn furnace_path() {
+    furnace_is_one(Mode::Path, Strategy::Mis);
+    furnace_is_one(Mode::Path, Strategy::Bsdf);
+}
+
+#[test]
+fn same_seed_same_bits_other_seed_other_bits() {
+    let ctx = gpu();
+    let scene = scene("veach-mis");
+    let s = small(48, 48);
+    let a = render(&ctx, &scene, &s, 8);
+    let b = render(&ctx, &scene, &s, 8);
+    let bits = |f: &mislab::film::Film| f.mean.iter().flat_map(|c| c.map(f32::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b), "the same seed and settings must give the same image bit for bit");
+    let c = render(&ctx, &scene, &Settings { seed: 7, ..s }, 8);
+    assert_ne!(bits(&a), bits(&c), "a different seed must change the image");
+}
+
+#[test]
+fn sample_counts_and_variance_are_consistent() {
+    let ctx = gpu();
+    let scene = scene("cornell-box");
+    let film = render(&ctx, &scene, &Settings { mode: Mode::Path, ..small(16, 16) }, 20);
+    assert_eq!(film.spp(), 20);
+    assert!(film.count.iter().all(|&c| c == 20), "every pixel must hold 20 samples");
+    assert!(film.m2.iter().flatten().all(|&m| m >= 0.0 && m.is_finite()));
+}
