@@ -72,6 +72,8 @@ fn schlick_weight(c: f32) -> f32 {
 
 /// Probability of choosing the specular lobe when sampling, from the lobes' approximate albedos at wo.
 fn bsdf_specular_probability(p: BsdfParams, wo: vec3<f32>) -> f32 {
+    if (!HAS_SPECULAR) { return 0.0; }
+    if (!HAS_DIFFUSE) { return 1.0; }
     let fw = schlick_weight(wo.z);
     let f_d = 0.04 * p.specular + (p.specular - 0.04 * p.specular) * fw;
     let f_m = luminance(p.base_color + (vec3<f32>(1.0) - p.base_color) * fw);
@@ -91,7 +93,7 @@ fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let f_d = f0_d + (p.specular - f0_d) * fw;
     let f_m = p.base_color + (vec3<f32>(1.0) - p.base_color) * fw;
     var spec = 0.0;
-    if (p.metallic > 0.0 || f_d > 0.0) {
+    if (HAS_SPECULAR && (p.metallic > 0.0 || f_d > 0.0)) {
         spec = ggx_d(h, p.alpha) * ggx_g2(wo, wi, p.alpha) / (4.0 * wo.z * wi.z);
     }
     let dielectric = (1.0 - f_d) * p.base_color * INV_PI + vec3<f32>(f_d * spec);
@@ -104,7 +106,7 @@ fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
     let ps = bsdf_specular_probability(p, wo);
     var pdf = (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
-    if (ps > 0.0) { pdf += ps * ggx_reflection_pdf(wo, wi, p.alpha); }
+    if (HAS_SPECULAR && ps > 0.0) { pdf += ps * ggx_reflection_pdf(wo, wi, p.alpha); }
     return pdf;
 }
 
@@ -116,7 +118,7 @@ fn bsdf_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfS
     s.f = vec3<f32>(0.0);
     if (wo.z <= 0.0) { return s; }
     let ps = bsdf_specular_probability(p, wo);
-    if (u_lobe < ps) {
+    if (HAS_SPECULAR && u_lobe < ps) {
         let h = ggx_sample_visible_normal(wo, p.alpha, u);
         s.wi = reflect(-wo, h);
     } else {

@@ -75,7 +75,7 @@ fn tri_edge(p: vec2<f32>, q: vec2<f32>) -> f32 {
     let swap = q.x < p.x || (q.x == p.x && q.y < p.y);
     let a = select(p, q, swap);
     let b = select(q, p, swap);
-    let e = a.x * b.y - a.y * b.x;
+    let e = fma(a.x, b.y, -(a.y * b.x));
     return select(e, -e, swap);
 }
 
@@ -166,16 +166,19 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
     let i = prim_index(prim);
     switch prim_kind(prim) {
         case PRIM_TRIANGLE: {
+            if (!HAS_TRIANGLES) { return vec4<f32>(0.0); }
             let v0 = tri_verts[3u * i].xyz;
             let v1 = tri_verts[3u * i + 1u].xyz;
             let v2 = tri_verts[3u * i + 2u].xyz;
             return intersect_triangle(r, v0, v1, v2, t_max);
         }
         case PRIM_SPHERE: {
+            if (!HAS_SPHERES) { return vec4<f32>(0.0); }
             let s = spheres[i];
             return intersect_sphere(r.o, r.d, s.center, s.radius, t_max);
         }
         case PRIM_QUAD: {
+            if (!HAS_QUADS) { return vec4<f32>(0.0); }
             return intersect_quad(r.o, r.d, quads[i], t_max);
         }
         default: {

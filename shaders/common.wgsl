@@ -217,3 +217,24 @@ fn any_nonfinite3(v: vec3<f32>) -> bool { return is_nonfinite(v.x) || is_nonfini
 fn luminance(c: vec3<f32>) -> f32 { return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722)); }
 fn sqr(x: f32) -> f32 { return x * x; }
 fn safe_sqrt(x: f32) -> f32 { return sqrt(max(x, 0.0)); }
+
+// ---- Scene features: pipeline-overridable constants (src/features.rs sets them). The default (true)
+// compiles every path; a specialised pipeline sets the ones a scene does not need to false, and the
+// driver removes that code. On lavapipe this matters: it runs SIMD lanes under masks, so code in a
+// branch that no lane takes still costs time unless it is compiled out.
+override HAS_TRIANGLES: bool = true;
+override HAS_SPHERES: bool = true;
+override HAS_QUADS: bool = true;
+override HAS_TRIANGLE_LIGHTS: bool = true;
+override HAS_SPHERE_LIGHTS: bool = true;
+override HAS_QUAD_LIGHTS: bool = true;
+override HAS_DELTA_LIGHTS: bool = true;
+/// 0: no environment, 1: constant, 2: equirectangular map, 3: either (generic).
+override ENV_KIND: u32 = 3u;
+override HAS_TEXTURES: bool = true;
+/// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
+override HAS_SPECULAR: bool = true;
+/// Whether any material has a diffuse lobe.
+override HAS_DIFFUSE: bool = true;
+/// More than one light: false skips light selection entirely.
+override MANY_LIGHTS: bool = true;

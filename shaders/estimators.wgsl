@@ -26,7 +26,7 @@ struct ShadingCtx {
 
 /// The direction technique a strategy uses: uniform, cosine, or the BSDF (also for light / mis).
 fn direction_technique() -> u32 {
-    if (params.strategy == STRATEGY_UNIFORM || params.strategy == STRATEGY_COSINE) { return params.strategy; }
+    if (cfg_strategy() == STRATEGY_UNIFORM || cfg_strategy() == STRATEGY_COSINE) { return cfg_strategy(); }
     return STRATEGY_BSDF;
 }
 
@@ -81,10 +81,19 @@ fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f
     let f = bsdf_eval(c.brdf, c.wo, wi_local);
     if (all(f * ls.radiance == vec3<f32>(0.0))) { return vec3<f32>(0.0); }
     let o = spawn_origin(c.x, ls.wi);
-    // Stop just short of the light point so the emitter itself does not count as an occluder.
-    let t_max = select(ls.dist * (1.0 - 2e-5), F32_MAX, ls.dist >= F32_MAX);
+    // The shadow ray runs from the offset origin o to the light point y and stops just short of y, so the
+    // emitter itself is no occluder. Aim at y from o (not along wi from x.p): at grazing angles a ray
+    // parallel to wi but offset by o − x.p reaches the light's plane well before distance |y − x.p|.
+    var shadow_dir = ls.wi;
+    var t_max = F32_MAX;
+    if (ls.dist < F32_MAX) {
+        let to_y = c.x.p + ls.wi * ls.dist - o;
+        let len = length(to_y);
+        shadow_dir = to_y / len;
+        t_max = len * (1.0 - 1e-5);
+    }
     rays_traced += 1u;
-    if (trace_any(o, ls.wi, t_max)) { return vec3<f32>(0.0); }
+    if (trace_any(o, shadow_dir, t_max)) { return vec3<f32>(0.0); }
     let p_light = pmf * ls.pdf;
     var w = 1.0;
     if (mis_n_dir > 0.0 && !ls.delta) {
@@ -128,16 +137,16 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     var n_light = 0u;
     var n_dir = 0u;
     var one_sample = false;
-    switch (params.strategy) {
+    switch (cfg_strategy()) {
         case STRATEGY_LIGHT: { n_light = params.light_samples; }
         case STRATEGY_MIS: {
             n_light = params.light_samples;
             n_dir = params.bsdf_samples;
-            one_sample = params.mis_kind == MIS_ONE;
+            one_sample = cfg_mis_kind() == MIS_ONE;
         }
         default: { n_dir = params.bsdf_samples; }
     }
-    let mis = params.strategy == STRATEGY_MIS;
+    let mis = cfg_strategy() == STRATEGY_MIS;
     var dir_count = n_dir;
     if (one_sample) {
         // One-sample MIS: pick the light technique with probability c_l = n_l / (n_l + n_d); the

@@ -21,7 +21,7 @@ fn radiance(px: vec2<u32>, id: SampleId) -> vec3<f32> {
     var hit = trace_closest(o, d, F32_MAX);
     var l = vec3<f32>(0.0);
     var beta = vec3<f32>(1.0);
-    let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, params.mode == MODE_DIRECT);
+    let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);
     for (var bounce = 0u; bounce < depth; bounce += 1u) {
         if (hit.prim == INVALID) {
             // Only the camera ray adds the environment here; later vertices counted it in shade().

@@ -20,7 +20,7 @@ fn no_light_sample() -> LightSample {
 /// Probability of choosing light `i` under the active selection scheme.
 fn light_pmf(i: u32) -> f32 {
     let l = lights[i];
-    return select(l.pmf_uniform, l.pmf_power, params.light_select == LIGHT_SELECT_POWER);
+    return select(l.pmf_uniform, l.pmf_power, cfg_light_select() == LIGHT_SELECT_POWER);
 }
 
 /// Samples an index from an alias table of `n` entries starting at `base` with one number u.
@@ -35,8 +35,9 @@ fn alias_sample(base: u32, n: u32, u: f32, table_is_env: bool) -> u32 {
 
 /// Chooses one light with probability `light_pmf`.
 fn select_light(u: f32) -> u32 {
+    if (!MANY_LIGHTS) { return 0u; }
     let n = params.num_lights;
-    if (params.light_select == LIGHT_SELECT_POWER) { return alias_sample(0u, n, u, false); }
+    if (cfg_light_select() == LIGHT_SELECT_POWER) { return alias_sample(0u, n, u, false); }
     return min(u32(u * f32(n)), n - 1u);
 }
 
@@ -172,13 +173,15 @@ fn env_texel_index(uv: vec2<f32>) -> u32 {
 
 /// Radiance arriving from direction w (piecewise constant over texels, matching the sampling density).
 fn env_eval(w: vec3<f32>) -> vec3<f32> {
-    if (params.env_width == 0u) { return params.env_constant * params.env_scale; }
+    if (ENV_KIND == 0u) { return vec3<f32>(0.0); }
+    if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u)) { return params.env_constant * params.env_scale; }
     return env_texels[env_texel_index(env_direction_to_uv(w))].xyz * params.env_scale;
 }
 
 /// pdf (solid angle) of `env_sample_li` producing w.
 fn env_pdf(w: vec3<f32>) -> f32 {
-    if (params.env_width == 0u || params.env_sampling == ENV_SAMPLING_UNIFORM) { return INV_FOUR_PI; }
+    if (ENV_KIND == 0u) { return 0.0; }
+    if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
     let density_uv = env_texels[env_texel_index(uv)].w;
     let sin_theta = safe_sqrt(1.0 - w.y * w.y);
@@ -189,7 +192,7 @@ fn env_pdf(w: vec3<f32>) -> f32 {
 /// inside the texel (so pdf_ω = density_uv / (2π² sinθ)).
 fn env_sample_li(u: vec3<f32>) -> LightSample {
     var wi: vec3<f32>;
-    if (params.env_width == 0u || params.env_sampling == ENV_SAMPLING_UNIFORM) {
+    if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) {
         wi = square_to_uniform_sphere(u.xy);
     } else {
         let n = params.env_width * params.env_height;
@@ -210,18 +213,20 @@ fn env_sample_li(u: vec3<f32>) -> LightSample {
 fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let l = lights[i];
     switch (l.kind) {
-        case LIGHT_TRIANGLE: { return triangle_sample_li(l.prim, p, u.xy); }
-        case LIGHT_QUAD: { return quad_sample_li(l.prim, p, u.xy); }
+        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_sample_li(l.prim, p, u.xy); } }
+        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_sample_li(l.prim, p, u.xy); } }
         case LIGHT_SPHERE: {
-            if (params.light_sampling == LIGHT_SAMPLING_SOLID_ANGLE) { return sphere_sample_li_cone(l.prim, p, u.xy); }
+            if (!HAS_SPHERE_LIGHTS) { return no_light_sample(); }
+            if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE) { return sphere_sample_li_cone(l.prim, p, u.xy); }
             return sphere_sample_li_area(l.prim, p, u.xy);
         }
-        case LIGHT_POINT: { return point_sample_li(l, p); }
-        case LIGHT_SPOT: { return spot_sample_li(l, p); }
-        case LIGHT_DIRECTIONAL: { return directional_sample_li(l); }
-        case LIGHT_ENVIRONMENT: { return env_sample_li(u); }
-        default: { return no_light_sample(); }
+        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_sample_li(l, p); } }
+        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_sample_li(l, p); } }
+        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_sample_li(l); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return env_sample_li(u); } }
+        default: {}
     }
+    return no_light_sample();
 }
 
 /// pdf (solid angle, without selection) that `light_sample_li` for light i produces the point y
@@ -229,7 +234,7 @@ fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
 fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
     let l = lights[i];
     if (l.kind == LIGHT_ENVIRONMENT) { return env_pdf(wi); }
-    if (l.kind == LIGHT_SPHERE && params.light_sampling == LIGHT_SAMPLING_SOLID_ANGLE) {
+    if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE && cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE) {
         let omc = sphere_cone_one_minus_cos(spheres[l.prim], p);
         if (omc > 0.0) { return square_to_uniform_cone_pdf(omc); }
     }

@@ -10,7 +10,7 @@ fn mis_weight(n_a: f32, p_a: f32, n_b: f32, p_b: f32) -> f32 {
     if (!(fb > 0.0)) { return 1.0; }
     let r = fb / fa;
     if (is_nonfinite(r)) { return select(1.0, 0.0, r > 1.0); }
-    if (params.heuristic == HEURISTIC_BALANCE) { return 1.0 / (1.0 + r); }
+    if (cfg_heuristic() == HEURISTIC_BALANCE) { return 1.0 / (1.0 + r); }
     let rb = pow(r, params.power_beta);
     if (is_nonfinite(rb)) { return 0.0; }
     return 1.0 / (1.0 + rb);

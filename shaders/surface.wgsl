@@ -19,7 +19,7 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
     let i = prim_index(hit.prim);
     var ng: vec3<f32>;
     var ns: vec3<f32>;
-    if (kind == PRIM_TRIANGLE) {
+    if (HAS_TRIANGLES && kind == PRIM_TRIANGLE) {
         let v0 = tri_verts[3u * i].xyz;
         let v1 = tri_verts[3u * i + 1u].xyz;
         let v2 = tri_verts[3u * i + 2u].xyz;
@@ -32,7 +32,7 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
         s.uv = b0 * sh.uv0 + hit.b1 * sh.uv1 + hit.b2 * sh.uv2;
         s.material = sh.material;
         s.light = sh.light;
-    } else if (kind == PRIM_SPHERE) {
+    } else if (HAS_SPHERES && kind == PRIM_SPHERE) {
         let sp = spheres[i];
         let q = o + hit.t * d;
         ng = normalize(q - sp.center);
@@ -41,7 +41,7 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
         s.uv = vec2<f32>(atan2(ng.z, ng.x) * INV_TWO_PI + 0.5, acos(clamp(ng.y, -1.0, 1.0)) * INV_PI);
         s.material = sp.material;
         s.light = sp.light;
-    } else {
+    } else if (HAS_QUADS) {
         let q = quads[i];
         s.p = q.corner + hit.b1 * q.edge_u + hit.b2 * q.edge_v;
         ng = normalize(cross(q.edge_u, q.edge_v));
@@ -113,10 +113,10 @@ fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) ->
 /// The material's BSDF parameters at `uv`.
 fn material_bsdf(m: Material, uv: vec2<f32>) -> BsdfParams {
     var p = BsdfParams(m.base_color, m.metallic, m.alpha, m.specular);
-    if (m.base_tex != INVALID) {
+    if (HAS_TEXTURES && m.base_tex != INVALID) {
         p.base_color *= texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
     }
-    if (m.mr_tex != INVALID) {
+    if (HAS_TEXTURES && m.mr_tex != INVALID) {
         let mr = texture_lookup(m.mr_tex, m.mr_xform0, m.mr_xform1, uv);
         // glTF: roughness in G, metallic in B; α = roughness².
         let rough = sqrt(m.alpha) * mr.y;
@@ -129,7 +129,7 @@ fn material_bsdf(m: Material, uv: vec2<f32>) -> BsdfParams {
 /// Emitted radiance of the material at `uv` (front face only; callers check `front`).
 fn material_emission(m: Material, uv: vec2<f32>) -> vec3<f32> {
     var e = m.emission;
-    if (m.emissive_tex != INVALID) {
+    if (HAS_TEXTURES && m.emissive_tex != INVALID) {
         e *= texture_lookup(m.emissive_tex, m.em_xform0, m.em_xform1, uv).xyz;
     }
     return e;

@@ -15,3 +15,4 @@ pub mod lights;
 pub mod render;
 pub mod settings;
 pub mod progressive;
+pub mod features;

@@ -1,6 +1,7 @@
 //! Renderer: the render pipeline, per-render buffers (frame parameters, accumulation, counters),
 //! progressive dispatch, reset and readback.
 
+use crate::features::{Features, PipelineKey};
 use crate::film::Film;
 use crate::gpu::{GpuContext, GpuError};
 use crate::gpu_scene::GpuScene;
@@ -14,6 +15,7 @@ pub const RENDER_FILES: &[&str] = &[
     "common.wgsl",
     "geometry_bindings.wgsl",
     "shading_bindings.wgsl",
+    "specialize.wgsl",
     "rng.wgsl",
     "samplers.wgsl",
     "warps.wgsl",
@@ -38,7 +40,12 @@ pub fn render_source() -> String {
 pub struct Renderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    pipeline: wgpu::ComputePipeline,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: std::collections::HashMap<PipelineKey, wgpu::ComputePipeline>,
+    /// The scene's features (what a specialised pipeline compiles in).
+    pub features: Features,
+    /// Whether pipelines are specialised to the settings (headless) or read them at run time (viewer).
+    pub specialize: bool,
     scene_group: wgpu::BindGroup,
     frame_group: wgpu::BindGroup,
     params_buffer: wgpu::Buffer,
@@ -67,8 +74,36 @@ impl Renderer {
     pub fn new(ctx: &GpuContext, scene: &GpuScene, camera: Camera, settings: Settings) -> Result<Renderer, String> {
         settings.validate()?;
         let device = ctx.device.clone();
-        let pipeline = shaders::compute_pipeline(&device, "render", &render_source(), "render_main", &[])?;
-        let layout0 = pipeline.get_bind_group_layout(0);
+        let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let scene_entries: Vec<_> = (0..scene.buffers.len() as u32).map(|i| storage(i, true)).collect();
+        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("scene"), entries: &scene_entries });
+        let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<GpuFrameParams>() as u64),
+                    },
+                    count: None,
+                },
+                storage(1, false),
+                storage(2, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("render"),
+            bind_group_layouts: &[Some(&layout0), Some(&layout1)],
+            immediate_size: 0,
+        });
         let entries: Vec<wgpu::BindGroupEntry> = scene
             .buffers
             .iter()
@@ -107,7 +142,7 @@ impl Renderer {
         });
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
-            layout: &pipeline.get_bind_group_layout(1),
+            layout: &layout1,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: accum.as_entire_binding() },
@@ -118,7 +153,10 @@ impl Renderer {
         let mut r = Renderer {
             device,
             queue: ctx.queue.clone(),
-            pipeline,
+            pipeline_layout,
+            pipelines: Default::default(),
+            features: Features::of(d),
+            specialize: true,
             scene_group,
             frame_group,
             params_buffer,
@@ -137,8 +175,35 @@ impl Renderer {
             num_lights: d.lights.len() as u32,
         };
         r.reset();
+        r.prepare()?;
         r.warm_up(ctx).map_err(|e| e.to_string())?;
         Ok(r)
+    }
+
+    /// The pipeline key the current settings need.
+    pub fn key(&self) -> PipelineKey {
+        if self.specialize {
+            PipelineKey::specialized(self.features, &self.settings)
+        } else {
+            PipelineKey::generic()
+        }
+    }
+
+    /// Builds (or finds in the cache) the pipeline for the current settings.
+    pub fn prepare(&mut self) -> Result<(), String> {
+        let key = self.key();
+        if !self.pipelines.contains_key(&key) {
+            let p = shaders::compute_pipeline(&self.device, "render", &render_source(), "render_main", &key.constants(), Some(&self.pipeline_layout))?;
+            self.pipelines.insert(key, p);
+        }
+        Ok(())
+    }
+
+    /// Switches between specialised and generic pipelines (the viewer runs the generic one while a
+    /// specialised one compiles). Does not reset: both compute the same estimate.
+    pub fn set_specialize(&mut self, on: bool) -> Result<(), String> {
+        self.specialize = on;
+        self.prepare()
     }
 
     /// Runs a zero-sample dispatch: drivers such as lavapipe compile the pipeline at its first use
@@ -171,7 +236,7 @@ impl Renderer {
         }
         self.settings = settings;
         self.reset();
-        Ok(())
+        self.prepare()
     }
 
     /// The frame parameters of a dispatch of `spp` samples starting at the current sample count.
@@ -222,7 +287,8 @@ impl Renderer {
         let p = self.frame_params(spp);
         self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: None });
-        pass.set_pipeline(&self.pipeline);
+        let pipeline = self.pipelines.get(&self.key()).expect("prepare() builds the pipeline before encoding");
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.scene_group, &[]);
         pass.set_bind_group(1, &self.frame_group, &[]);
         pass.dispatch_workgroups(self.settings.width.div_ceil(8), self.settings.height.div_ceil(8), 1);

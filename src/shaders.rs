@@ -7,6 +7,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("geometry_bindings.wgsl", include_str!("../shaders/geometry_bindings.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
     ("shading_bindings.wgsl", include_str!("../shaders/shading_bindings.wgsl")),
+    ("specialize.wgsl", include_str!("../shaders/specialize.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("samplers.wgsl", include_str!("../shaders/samplers.wgsl")),
     ("warps.wgsl", include_str!("../shaders/warps.wgsl")),
@@ -55,6 +56,7 @@ pub fn compute_pipeline(
     source: &str,
     entry: &str,
     constants: &[(&str, f64)],
+    layout: Option<&wgpu::PipelineLayout>,
 ) -> Result<wgpu::ComputePipeline, String> {
     validate(source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -63,7 +65,7 @@ pub fn compute_pipeline(
     });
     Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
-        layout: None,
+        layout,
         module: &module,
         entry_point: Some(entry),
         compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: false },

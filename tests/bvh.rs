@@ -233,7 +233,9 @@ fn f32_error_units(g: &Geometry, prim: u32, r: &Ray, t: f64) -> (f64, f64) {
         PRIM_TRIANGLE => {
             let v = g.tris[i].map(|p| p.as_dvec3());
             let n = (v[1] - v[0]).cross(v[2] - v[0]);
-            (dn.dot(n.normalize()).abs(), n.length().sqrt())
+            // Size: the smallest altitude, which bounds the barycentrics' sensitivity (slivers!).
+            let longest = (v[1] - v[0]).length().max((v[2] - v[1]).length()).max((v[0] - v[2]).length());
+            (dn.dot(n.normalize()).abs(), n.length() / longest)
         }
         PRIM_SPHERE => {
             let c = Vec3::from(g.spheres[i].center).as_dvec3();
@@ -241,8 +243,9 @@ fn f32_error_units(g: &Geometry, prim: u32, r: &Ray, t: f64) -> (f64, f64) {
         }
         _ => {
             let q = &g.quads[i];
-            let n = Vec3::from(q.edge_u).as_dvec3().cross(Vec3::from(q.edge_v).as_dvec3());
-            (dn.dot(n.normalize()).abs(), n.length().sqrt())
+            let (u, v) = (Vec3::from(q.edge_u).as_dvec3(), Vec3::from(q.edge_v).as_dvec3());
+            let n = u.cross(v);
+            (dn.dot(n.normalize()).abs(), n.length() / u.length().max(v.length()))
         }
     };
     let scale = r.o.abs().max_element() + hit.abs().max_element();
@@ -751,6 +754,74 @@ fn gpu_far_small_sphere() {
     assert!(s.hits > 4000, "{} hits", s.hits);
 }
 
+/// A closed, bumpy "cube sphere": six n×n grids whose vertices are a function of their integer lattice point, so
+/// the vertices shared across faces are bit-identical. Rotated randomly, scaled by `size`, moved to `center`.
+fn closed_mesh(n: i32, size: f32, center: Vec3, rng: &mut Pcg64) -> Vec<[Vec3; 3]> {
+    let rot = glam::Quat::from_axis_angle(unit(rng).as_vec3(), rng.random_range(0.0..6.28));
+    let vert = |p: glam::IVec3| {
+        let c = (p.as_vec3() / n as f32) * 2.0 - 1.0;
+        let bump = 1.0 + 0.15 * (3.0 * c.x).sin() * (2.0 * c.y).cos() * (2.5 * c.z + 1.0).sin();
+        center + rot * (c.normalize() * bump * size)
+    };
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        for side in [0, n] {
+            for i in 0..n {
+                for j in 0..n {
+                    let p = |a: i32, b: i32| {
+                        let mut v = glam::IVec3::ZERO;
+                        v[axis] = side;
+                        v[(axis + 1) % 3] = a;
+                        v[(axis + 2) % 3] = b;
+                        vert(v)
+                    };
+                    let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+                    // Alternate the diagonal so vertices have different valences.
+                    if (i + j) % 2 == 0 {
+                        tris.push([a, b, c]);
+                        tris.push([a, c, d]);
+                    } else {
+                        tris.push([a, b, d]);
+                        tris.push([b, c, d]);
+                    }
+                }
+            }
+        }
+    }
+    tris
+}
+
+#[test]
+fn gpu_watertight_through_edges_and_vertices() {
+    // Rays from near the centre of a closed star-shaped mesh, aimed exactly at its shared edges and vertices, cross
+    // the surface exactly once, transversally: each must hit at the aim point. A crack between adjacent triangles
+    // (edge functions of the two triangles disagreeing in sign) would let some through.
+    let ctx = gpu();
+    let mut rng = Pcg64::seed_from_u64(31);
+    for (center, size) in [(Vec3::ZERO, 1.0f32), (Vec3::new(700.0, -300.0, 1200.0), 50.0)] {
+        let tris = closed_mesh(12, size, center, &mut rng);
+        let g = Geometry { tris, spheres: vec![], quads: vec![] };
+        let b = g.build();
+        let rays: Vec<(f64, ProbeRay)> = (0..50_000)
+            .map(|k| {
+                let t = g.tris[rng.random_range(0..g.tris.len())];
+                let e = rng.random_range(0..3);
+                // A vertex, or a point on an edge interpolated in f32 as a renderer would.
+                let target = if k % 4 == 0 { t[e] } else { t[e].lerp(t[(e + 1) % 3], rng.random::<f32>()) };
+                let o = center + (unit(&mut rng) * 0.05).as_vec3() * size * rng.random::<f32>();
+                let d = (target - o).normalize();
+                ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
+            })
+            .collect();
+        let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
+        let out = gpu_trace(&ctx, &g, &b, &inputs);
+        let misses = out.iter().filter(|h| h.prim == INVALID).count();
+        let far = out.iter().zip(&rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-4).count();
+        assert_eq!(misses, 0, "{misses} of {} rays through edges/vertices leaked (mesh at {center}, size {size})", rays.len());
+        assert_eq!(far, 0, "{far} rays hit away from their aim point (mesh at {center}, size {size})");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // GPU: offset_ray_origin
 
@@ -860,4 +931,5 @@ fn probe_reports_sentinel_and_shader_errors() {
     let err = probe.map::<f32, f32>("fn twice(x: f32) -> f32 { return 2.0 * y; }", "f32", "f32", "twice", &[1.0], None).unwrap_err();
     assert!(err.to_string().contains("y"), "{err}");
 }
+
 

@@ -109,7 +109,8 @@ fn expected(v: &Value, scene: Option<usize>) -> Expected {
     let scene = scene.or(v["scene"].as_u64().map(|s| s as usize)).unwrap_or(0);
     let mut e = Expected::default();
     let mut materials = HashSet::new();
-    let mut stack: Vec<u64> = v["scenes"][scene]["nodes"].as_array().unwrap().iter().rev().map(|n| n.as_u64().unwrap()).collect();
+    let mut stack: Vec<u64> =
+        v["scenes"][scene]["nodes"].as_array().unwrap().iter().rev().map(|n| n.as_u64().unwrap()).collect();
     while let Some(n) = stack.pop() {
         let node = &v["nodes"][n as usize];
         if let Some(mesh) = node["mesh"].as_u64() {
@@ -200,7 +201,11 @@ fn damaged_helmet_textures_and_emission() {
     assert_eq!(s.triangle_count(), 15452);
     assert_eq!(s.materials.len(), 1);
     let m = &s.materials[0];
-    let (base, mr, emissive) = (m.base_color_texture.as_ref().unwrap(), m.metallic_roughness_texture.as_ref().unwrap(), m.emissive_texture.as_ref().unwrap());
+    let (base, mr, emissive) = (
+        m.base_color_texture.as_ref().unwrap(),
+        m.metallic_roughness_texture.as_ref().unwrap(),
+        m.emissive_texture.as_ref().unwrap(),
+    );
     assert!(s.textures[base.texture as usize].srgb);
     assert!(!s.textures[mr.texture as usize].srgb);
     assert!(s.textures[emissive.texture as usize].srgb);
@@ -234,7 +239,10 @@ fn punctual_lights_of_the_lamp() {
     assert_eq!(s.punctual_lights.len(), 5);
     // Light 0 ("Point"): colour (1, 0.631875, 0.2390998) × intensity 15, from the JSON.
     let want = Vec3::new(1.0, 0.631_875, 0.239_099_76) * 15.0;
-    let found = s.punctual_lights.iter().any(|l| matches!(l, PunctualLight::Point { intensity, .. } if close3(*intensity, want, 1e-5)));
+    let found = s
+        .punctual_lights
+        .iter()
+        .any(|l| matches!(l, PunctualLight::Point { intensity, .. } if close3(*intensity, want, 1e-5)));
     assert!(found, "{:?}", s.punctual_lights);
     for l in &s.punctual_lights {
         let PunctualLight::Point { position, .. } = l else { panic!("all lamp lights are points") };
@@ -287,7 +295,10 @@ fn sparse_accessor_values_are_applied() {
     let acc = &v["accessors"][1];
     let view = |i: u64| v["bufferViews"][i as usize]["byteOffset"].as_u64().unwrap() as usize;
     let sparse = &acc["sparse"];
-    let (ind, val) = (view(sparse["indices"]["bufferView"].as_u64().unwrap()), view(sparse["values"]["bufferView"].as_u64().unwrap()));
+    let (ind, val) = (
+        view(sparse["indices"]["bufferView"].as_u64().unwrap()),
+        view(sparse["values"]["bufferView"].as_u64().unwrap()),
+    );
     let base = view(acc["bufferView"].as_u64().unwrap());
     let f = |at: usize| f32::from_le_bytes(buf[at..at + 4].try_into().unwrap());
     let s = load_ok(&path);
@@ -524,11 +535,14 @@ fn robustness_corpus() {
     assert_eq!(files.len(), table.len(), "update the table: {files:?}");
     for f in files {
         let shown = f.to_string_lossy();
-        let (_, err, warning) = table.iter().find(|(name, ..)| shown.ends_with(name)).unwrap_or_else(|| panic!("{shown} not in the table"));
+        let (_, err, warning) =
+            table.iter().find(|(name, ..)| shown.ends_with(name)).unwrap_or_else(|| panic!("{shown} not in the table"));
         let file_name = f.file_name().unwrap().to_string_lossy();
         match (load_no_panic(&f), err) {
             (Err(e), Some(want)) => assert!(e.contains(&*file_name) && e.contains(want), "{e}"),
-            (Ok(s), None) if warning.is_empty() => assert!(s.warnings.is_empty() && s.triangle_count() > 0, "{shown}: {:?}", s.warnings),
+            (Ok(s), None) if warning.is_empty() => {
+                assert!(s.warnings.is_empty() && s.triangle_count() > 0, "{shown}: {:?}", s.warnings)
+            }
             (Ok(s), None) => assert!(s.warnings.iter().any(|w| w.contains(warning)), "{shown}: {:?}", s.warnings),
             (result, _) => panic!("{shown}: unexpected {:?}", result.map(|s| s.warnings)),
         }
@@ -665,16 +679,28 @@ fn hand_made_valid_triangle() {
 fn hand_made_defects_give_specific_errors() {
     type Edit = fn(&mut Value);
     let cases: &[(&str, Edit, &str)] = &[
-        ("missing-accessor", |v| v["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 7.into(), "accessor 7 (POSITION of mesh 'Tri' primitive 0) does not exist"),
-        ("stride", |v| v["bufferViews"][0]["byteStride"] = 4.into(), "accessor 0 (POSITION of mesh 'Tri' primitive 0): byteStride 4 is smaller than the element size 12"),
+        (
+            "missing-accessor",
+            |v| v["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 7.into(),
+            "accessor 7 (POSITION of mesh 'Tri' primitive 0) does not exist",
+        ),
+        (
+            "stride",
+            |v| v["bufferViews"][0]["byteStride"] = 4.into(),
+            "accessor 0 (POSITION of mesh 'Tri' primitive 0): byteStride 4 is smaller than the element size 12",
+        ),
         ("past-view", |v| v["accessors"][0]["count"] = 10.into(), "do not fit in bufferView 0"),
         ("offset-past-view", |v| v["accessors"][0]["byteOffset"] = 4.into(), "do not fit in bufferView 0"),
         ("view-past-buffer", |v| v["bufferViews"][2]["byteLength"] = 400.into(), "extends past the end of buffer 0"),
         ("short-buffer", |v| v["buffers"][0]["byteLength"] = 1000.into(), "byteLength is 1000 but only 80 bytes"),
-        ("index-range", |v| {
-            v["accessors"][0]["count"] = 2.into();
-            v["meshes"][0]["primitives"][0]["attributes"] = parse(r#"{"POSITION": 0}"#);
-        }, "index 2 at position 2 is out of range (the primitive has 2 vertices)"),
+        (
+            "index-range",
+            |v| {
+                v["accessors"][0]["count"] = 2.into();
+                v["meshes"][0]["primitives"][0]["attributes"] = parse(r#"{"POSITION": 0}"#);
+            },
+            "index 2 at position 2 is out of range (the primitive has 2 vertices)",
+        ),
         ("normal-count", |v| v["accessors"][2]["count"] = 2.into(), "count 2 differs from the POSITION count 3"),
         ("cycle", |v| v["nodes"] = parse(r#"[{"mesh": 0, "children": [1]}, {"children": [0]}]"#), "cycle"),
         ("self-cycle", |v| v["nodes"][0]["children"] = parse("[0]"), "cycle"),
@@ -686,22 +712,48 @@ fn hand_made_defects_give_specific_errors() {
         ("component", |v| v["accessors"][0]["componentType"] = 5123.into(), "componentType 5123"),
         ("type", |v| v["accessors"][0]["type"] = "VEC2".into(), "type VEC2 is not valid for POSITION"),
         ("index-type", |v| v["accessors"][1]["componentType"] = 5126.into(), "not valid for indices"),
-        ("huge-count", |v| v["accessors"][0] = parse(r#"{"componentType": 5126, "count": 4000000000, "type": "VEC3"}"#), "exceeds the limit"),
-        ("bad-base64", |v| v["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@@@".into(), "invalid base64"),
-        ("plain-data-uri", |v| v["buffers"][0]["uri"] = "data:application/octet-stream,abc".into(), "not base64-encoded"),
+        (
+            "huge-count",
+            |v| v["accessors"][0] = parse(r#"{"componentType": 5126, "count": 4000000000, "type": "VEC3"}"#),
+            "exceeds the limit",
+        ),
+        (
+            "bad-base64",
+            |v| v["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@@@".into(),
+            "invalid base64",
+        ),
+        (
+            "plain-data-uri",
+            |v| v["buffers"][0]["uri"] = "data:application/octet-stream,abc".into(),
+            "not base64-encoded",
+        ),
         ("remote-uri", |v| v["buffers"][0]["uri"] = "https://example.com/a.bin".into(), "nothing is downloaded"),
         ("missing-bin", |v| v["buffers"][0]["uri"] = "nothere.bin".into(), "nothere.bin"),
         ("bad-rotation", |v| v["nodes"][0]["rotation"] = parse("[0, 0, 0, 0]"), "not a valid quaternion"),
         ("bad-scene", |v| v["scene"] = 3.into(), "scene 3 is the default scene, but the file has 1 scene"),
-        ("required-ext", |v| v["extensionsRequired"] = parse(r#"["EXT_meshopt_compression"]"#), "EXT_meshopt_compression"),
+        (
+            "required-ext",
+            |v| v["extensionsRequired"] = parse(r#"["EXT_meshopt_compression"]"#),
+            "EXT_meshopt_compression",
+        ),
         ("quantization", |v| v["extensionsRequired"] = parse(r#"["KHR_mesh_quantization"]"#), "KHR_mesh_quantization"),
         ("bad-mode", |v| v["meshes"][0]["primitives"][0]["mode"] = 9.into(), "invalid primitive mode"),
-        ("sparse-range", |v| {
-            // Two positions; the sparse index is read from the index view's third entry, 2.
-            v["accessors"][0]["count"] = 2.into();
-            v["accessors"][0]["sparse"] = parse(r#"{"count": 1, "indices": {"bufferView": 1, "byteOffset": 4, "componentType": 5123}, "values": {"bufferView": 2}}"#);
-        }, "sparse index 2 (entry 0) is out of range: the accessor has 2 elements"),
-        ("missing-light", |v| v["nodes"][0]["extensions"] = parse(r#"{"KHR_lights_punctual": {"light": 0}}"#), "KHR_lights_punctual light 0 does not exist"),
+        (
+            "sparse-range",
+            |v| {
+                // Two positions; the sparse index is read from the index view's third entry, 2.
+                v["accessors"][0]["count"] = 2.into();
+                v["accessors"][0]["sparse"] = parse(
+                    r#"{"count": 1, "indices": {"bufferView": 1, "byteOffset": 4, "componentType": 5123}, "values": {"bufferView": 2}}"#,
+                );
+            },
+            "sparse index 2 (entry 0) is out of range: the accessor has 2 elements",
+        ),
+        (
+            "missing-light",
+            |v| v["nodes"][0]["extensions"] = parse(r#"{"KHR_lights_punctual": {"light": 0}}"#),
+            "KHR_lights_punctual light 0 does not exist",
+        ),
     ];
     let dir = scratch("defects");
     for (name, edit, want) in cases {
@@ -818,9 +870,11 @@ fn texture_files_sizes_and_errors() {
     assert!(e.contains("junk.png") && e.contains("cannot decode"), "{e}");
     let e = load_no_panic(&textured(&dir, "absent.gltf", "absent%20file.png", |_| {})).unwrap_err();
     assert!(e.contains("absent file.png") && e.contains("cannot read"), "{e}");
-    let e = load_no_panic(&textured(&dir, "bad-tex.gltf", "one.png", |v| v["textures"][0]["source"] = 4.into())).unwrap_err();
+    let e = load_no_panic(&textured(&dir, "bad-tex.gltf", "one.png", |v| v["textures"][0]["source"] = 4.into()))
+        .unwrap_err();
     assert!(e.contains("image 4 does not exist"), "{e}");
-    let e = load_no_panic(&textured(&dir, "bad-sampler.gltf", "one.png", |v| v["textures"][0]["sampler"] = 2.into())).unwrap_err();
+    let e = load_no_panic(&textured(&dir, "bad-sampler.gltf", "one.png", |v| v["textures"][0]["sampler"] = 2.into()))
+        .unwrap_err();
     assert!(e.contains("sampler 2 does not exist"), "{e}");
 }
 
@@ -831,9 +885,8 @@ fn one_image_two_colour_spaces_and_texcoord_override() {
     let path = textured(&dir, "both.gltf", "img.png", |v| {
         v["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = parse(r#"{"index": 0}"#);
         v["materials"][0]["emissiveFactor"] = parse("[1, 1, 1]");
-        v["materials"][0]["emissiveTexture"] = parse(
-            r#"{"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1, "offset": [0.25, 0]}}}"#,
-        );
+        v["materials"][0]["emissiveTexture"] =
+            parse(r#"{"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1, "offset": [0.25, 0]}}}"#);
         v["samplers"] = parse(r#"[{"magFilter": 9728, "wrapS": 33648, "wrapT": 33071}]"#);
         v["textures"][0]["sampler"] = 0.into();
     });
@@ -841,7 +894,11 @@ fn one_image_two_colour_spaces_and_texcoord_override() {
     let m = &s.materials[0];
     // Base colour and emissive share the sRGB texture; metallic-roughness gets its own linear copy.
     assert_eq!(s.textures.len(), 2);
-    let (base, mr, em) = (m.base_color_texture.as_ref().unwrap(), m.metallic_roughness_texture.as_ref().unwrap(), m.emissive_texture.as_ref().unwrap());
+    let (base, mr, em) = (
+        m.base_color_texture.as_ref().unwrap(),
+        m.metallic_roughness_texture.as_ref().unwrap(),
+        m.emissive_texture.as_ref().unwrap(),
+    );
     assert_eq!(base.texture, em.texture);
     assert_ne!(base.texture, mr.texture);
     assert!(s.textures[base.texture as usize].srgb && !s.textures[mr.texture as usize].srgb);
@@ -874,13 +931,18 @@ fn lights_cameras_and_scenes_from_hand_made_nodes() {
     );
     let s = load_no_panic(&write_json(&dir, "lights.gltf", &v)).unwrap();
     assert_eq!(s.punctual_lights.len(), 2, "the negative-intensity light is skipped");
-    let PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } = &s.punctual_lights[0] else { panic!() };
+    let PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } = &s.punctual_lights[0] else {
+        panic!()
+    };
     // Rotating -90° about X turns the node's -Z into -Y: the spot points down.
     assert!(close3(*position, Vec3::new(1.0, 2.0, 3.0), 1e-6));
     assert!(close3(*direction, Vec3::NEG_Y, 1e-6), "{direction}");
     assert!(close3(*intensity, Vec3::new(4.0, 2.0, 1.0), 1e-6));
     assert_eq!((*inner_cone, *outer_cone), (0.0, std::f32::consts::FRAC_PI_4));
-    assert_eq!(s.punctual_lights[1], PunctualLight::Directional { direction: Vec3::NEG_Z, irradiance: Vec3::splat(2.0) });
+    assert_eq!(
+        s.punctual_lights[1],
+        PunctualLight::Directional { direction: Vec3::NEG_Z, irradiance: Vec3::splat(2.0) }
+    );
     assert!(s.warnings.iter().any(|w| w.contains("light 2")), "{:?}", s.warnings);
     assert!(close3(s.camera.position, Vec3::new(0.0, 0.0, 10.0), 1e-6) && s.camera.vfov == 0.5);
 }
@@ -908,4 +970,28 @@ fn scenes_missing_or_empty() {
     let s = load_no_panic(&write_json(&dir, "shared.gltf", &v)).unwrap();
     assert_eq!(s.meshes.len(), 2);
     assert_eq!(s.meshes[1].positions[0], Vec3::new(5.0, 0.0, 0.0));
+}
+
+#[test]
+fn deep_and_exploding_hierarchies_are_bounded() {
+    let dir = scratch("deep");
+    let chain = |n: usize| -> Value {
+        let nodes: Vec<String> = (0..n)
+            .map(|i| if i + 1 < n { format!(r#"{{"children": [{}]}}"#, i + 1) } else { r#"{"mesh": 0}"#.into() })
+            .collect();
+        parse(&format!("[{}]", nodes.join(",")))
+    };
+    // 400 levels load (and do not overflow the stack); 600 exceed the depth limit.
+    let mut v = triangle_gltf();
+    v["nodes"] = chain(400);
+    assert_eq!(load_no_panic(&write_json(&dir, "deep400.gltf", &v)).unwrap().triangle_count(), 1);
+    v["nodes"] = chain(600);
+    let e = load_no_panic(&write_json(&dir, "deep600.gltf", &v)).unwrap_err();
+    assert!(e.contains("deep600.gltf") && e.contains("deeper than"), "{e}");
+    // Each node lists its successor twice: 2^40 instances if followed naively.
+    let nodes: Vec<String> =
+        (0..40).map(|i| format!(r#"{{"children": [{0}, {0}]}}"#, i + 1)).chain([r#"{"mesh": 0}"#.into()]).collect();
+    v["nodes"] = parse(&format!("[{}]", nodes.join(",")));
+    let e = load_no_panic(&write_json(&dir, "bomb.gltf", &v)).unwrap_err();
+    assert!(e.contains("bomb.gltf") && e.contains("node instances"), "{e}");
 }

@@ -144,7 +144,9 @@ fn cornell_box_matches_readme() {
     assert_eq!(s.quads.iter().filter(|q| mat(q).is_emissive()).count(), 1);
 
     // Boxes: the README's vertices and indices, outward winding, flat unit normals equal to the face normals.
-    for (mesh, (name, verts)) in s.meshes.iter().zip([("shortbox", &builtin::CORNELL_SHORTBOX), ("tallbox", &builtin::CORNELL_TALLBOX)]) {
+    for (mesh, (name, verts)) in
+        s.meshes.iter().zip([("shortbox", &builtin::CORNELL_SHORTBOX), ("tallbox", &builtin::CORNELL_TALLBOX)])
+    {
         assert_eq!(mesh.name, name);
         assert_eq!(mesh.positions, verts.map(Vec3::from).to_vec());
         assert_eq!(mesh.indices, builtin::CORNELL_BOX_INDICES.to_vec());
@@ -207,7 +209,10 @@ fn area_vs_cosine_shows_both_regions() {
         let d = (f + r * fx * t + u * fy * t).normalize();
         let p = c.position + d * (-c.position.y / d.y);
         assert!(d.y < 0.0 && p.x.abs() < 10.0 && p.z.abs() < 10.0, "film ({fx}, {fy}) misses the floor");
-        assert!(p.x - (light.corner.x + light.edge_u.x) > 6.0 * height, "film ({fx}, {fy}) is floor at {p}, too near the light");
+        assert!(
+            p.x - (light.corner.x + light.edge_u.x) > 6.0 * height,
+            "film ({fx}, {fy}) is floor at {p}, too near the light"
+        );
     }
 }
 
@@ -229,8 +234,16 @@ fn same_quad(a: &Quad, b: &Quad) -> bool {
 fn assert_same_scene(toml: &Scene, builtin: &Scene) {
     let who = &toml.name;
     assert_eq!(toml.camera.position, builtin.camera.position, "{who}: camera");
-    assert!(close(toml.camera.forward, builtin.camera.forward, 1e-6) && (toml.camera.vfov - builtin.camera.vfov).abs() < 1e-6, "{who}: camera");
-    assert_eq!((toml.quads.len(), toml.spheres.len(), toml.meshes.len()), (builtin.quads.len(), builtin.spheres.len(), builtin.meshes.len()), "{who}");
+    assert!(
+        close(toml.camera.forward, builtin.camera.forward, 1e-6)
+            && (toml.camera.vfov - builtin.camera.vfov).abs() < 1e-6,
+        "{who}: camera"
+    );
+    assert_eq!(
+        (toml.quads.len(), toml.spheres.len(), toml.meshes.len()),
+        (builtin.quads.len(), builtin.spheres.len(), builtin.meshes.len()),
+        "{who}"
+    );
     for b in &builtin.quads {
         let t = toml.quads.iter().find(|t| same_quad(t, b)).unwrap_or_else(|| panic!("{who}: no quad like {b:?}"));
         assert_eq!(material_of(toml, t.material), material_of(builtin, b.material), "{who}: material of {b:?}");
@@ -285,7 +298,8 @@ fn env_map_example_loads() {
     assert_eq!(*scale, 1.0);
     assert!((rotation.to_degrees() - 30.0).abs() < 1e-4);
     assert_eq!((s.spheres.len(), s.quads.len()), (3, 1));
-    let kinds: Vec<_> = s.spheres.iter().map(|x| &s.materials[x.material as usize]).map(|m| (m.metallic, m.specular)).collect();
+    let kinds: Vec<_> =
+        s.spheres.iter().map(|x| &s.materials[x.material as usize]).map(|m| (m.metallic, m.specular)).collect();
     assert_eq!(kinds, vec![(0.0, 0.0), (1.0, 1.0), (0.0, 1.0)], "diffuse, conductor, plastic");
 }
 
@@ -361,9 +375,15 @@ constant = [0.1, 0.2, 0.3]
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.name, "features");
-    assert_eq!((s.camera.position, s.camera.forward, s.camera.vfov), (Vec3::new(1.0, 2.0, 3.0), Vec3::NEG_Z, 45f32.to_radians()));
+    assert_eq!(
+        (s.camera.position, s.camera.forward, s.camera.vfov),
+        (Vec3::new(1.0, 2.0, 3.0), Vec3::NEG_Z, 45f32.to_radians())
+    );
     let mr = s.materials.iter().find(|m| m.name == "mr").unwrap();
-    assert_eq!((mr.base_color, mr.metallic, mr.roughness, mr.specular, mr.emission), (Vec3::new(0.9, 0.5, 0.1), 0.0, 0.25, 0.5, Vec3::new(1.0, 2.0, 3.0)));
+    assert_eq!(
+        (mr.base_color, mr.metallic, mr.roughness, mr.specular, mr.emission),
+        (Vec3::new(0.9, 0.5, 0.1), 0.0, 0.25, 0.5, Vec3::new(1.0, 2.0, 3.0))
+    );
     assert_eq!(s.materials.iter().find(|m| m.name == "plain").unwrap(), &Material::lambert("plain", Vec3::splat(0.8)));
     // Rectangle: centred, front along the normal, sizes along (u, v).
     let r = &s.quads[0];
@@ -373,8 +393,13 @@ constant = [0.1, 0.2, 0.3]
     assert!(close(r.edge_u, Vec3::Y, 1e-6) && close(quad_normal(r), Vec3::Z, 1e-6));
     assert_eq!(s.meshes[0].normals, vec![Vec3::Z; 3]);
     assert_eq!(s.meshes[0].name, "mesh1");
-    assert_eq!(s.punctual_lights[0], PunctualLight::Point { position: Vec3::new(0.0, 5.0, 0.0), intensity: Vec3::splat(10.0) });
-    let PunctualLight::Spot { direction, intensity, inner_cone, outer_cone, .. } = &s.punctual_lights[1] else { panic!() };
+    assert_eq!(
+        s.punctual_lights[0],
+        PunctualLight::Point { position: Vec3::new(0.0, 5.0, 0.0), intensity: Vec3::splat(10.0) }
+    );
+    let PunctualLight::Spot { direction, intensity, inner_cone, outer_cone, .. } = &s.punctual_lights[1] else {
+        panic!()
+    };
     assert_eq!((*direction, *intensity), (Vec3::NEG_Y, Vec3::new(1.0, 2.0, 3.0)));
     assert!((inner_cone.to_degrees() - 10.0).abs() < 1e-4 && (outer_cone.to_degrees() - 20.0).abs() < 1e-4);
     let PunctualLight::Directional { direction, irradiance } = &s.punctual_lights[2] else { panic!() };
@@ -382,7 +407,12 @@ constant = [0.1, 0.2, 0.3]
     assert!(matches!(s.environment, Environment::Constant(c) if c == Vec3::new(0.1, 0.2, 0.3)));
 
     // No lights and no environment is valid (the renderer warns), and so is an empty file.
-    let dark = load_text(&dir, "dark.toml", "[materials.a]\ntype = \"lambert\"\n[[sphere]]\ncenter = [0,0,0]\nradius = 1\nmaterial = \"a\"\n").unwrap();
+    let dark = load_text(
+        &dir,
+        "dark.toml",
+        "[materials.a]\ntype = \"lambert\"\n[[sphere]]\ncenter = [0,0,0]\nradius = 1\nmaterial = \"a\"\n",
+    )
+    .unwrap();
     assert!(!dark.has_lights());
     assert!(load_text(&dir, "empty.toml", "").is_ok());
     // Reflectance above 1 is allowed but warned about.
@@ -485,8 +515,15 @@ use_camera = true
     assert_eq!(s.meshes.len(), 2 * n);
     assert_eq!(s.materials.len(), 1 + 2 * plain.materials.len());
     assert_eq!(s.triangle_count(), 2 * plain.triangle_count());
-    assert_eq!(s.camera.position, Vec3::new(-plain.camera.position.x, plain.camera.position.y, plain.camera.position.z));
-    let m = glam::Mat4::from_scale_rotation_translation(Vec3::splat(2.0), glam::Quat::from_rotation_y(90f32.to_radians()), Vec3::new(10.0, 0.0, 0.0));
+    assert_eq!(
+        s.camera.position,
+        Vec3::new(-plain.camera.position.x, plain.camera.position.y, plain.camera.position.z)
+    );
+    let m = glam::Mat4::from_scale_rotation_translation(
+        Vec3::splat(2.0),
+        glam::Quat::from_rotation_y(90f32.to_radians()),
+        Vec3::new(10.0, 0.0, 0.0),
+    );
     for (k, (a, b)) in plain.meshes.iter().zip(&s.meshes[..n]).enumerate() {
         assert_eq!(b.material, a.material + 1, "materials re-indexed after the TOML's own");
         assert_eq!(s.materials[b.material as usize], plain.materials[a.material as usize]);
@@ -547,7 +584,11 @@ fn every_test_env_map_loads() {
     // The lossless EXR re-encode decodes to the same texels as its source HDR.
     let (hdr, _) = load_envmap(&Path::new(TESTDATA_ENV).join("hdr/noon_grass_1k.hdr")).unwrap();
     let (exr, _) = load_envmap(&Path::new(TESTDATA_ENV).join("exr/derived/noon_grass_1k_f32_zip.exr")).unwrap();
-    assert!(hdr.texels.iter().zip(&exr.texels).all(|(a, b)| (0..3).all(|i| (a[i] - b[i]).abs() <= 1e-6 * a[i].max(1.0))));
+    assert!(hdr
+        .texels
+        .iter()
+        .zip(&exr.texels)
+        .all(|(a, b)| (0..3).all(|i| (a[i] - b[i]).abs() <= 1e-6 * a[i].max(1.0))));
     // Top row is the sky: the noon map's brightest texel (the sun) is in the upper half.
     let brightest = hdr.texels.iter().enumerate().max_by(|a, b| a.1[1].total_cmp(&b.1[1])).unwrap().0;
     assert!(brightest / 1024 < 256);
@@ -597,7 +638,10 @@ fn env_map_sanitises_bad_texels() {
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     let w = &warnings[0];
     assert!(w.contains("bad.exr") && w.contains("repaired 5 of 8 texels"), "{w}");
-    assert!(w.contains("1 NaN") && w.contains("2 infinite") && w.contains("1 negative") && w.contains("1 above 1e30"), "{w}");
+    assert!(
+        w.contains("1 NaN") && w.contains("2 infinite") && w.contains("1 negative") && w.contains("1 above 1e30"),
+        "{w}"
+    );
 
     // Radiance file with an exponent-255 texel, which the decoder turns into ~1.7e38: flat RGBE, 2×1.
     let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
@@ -668,7 +712,8 @@ fn sky_texel(x: u32, y: u32) -> Vec3 {
 #[ignore]
 fn regenerate_sky_hdr() {
     let (w, h) = SKY_SIZE;
-    let pixels: Vec<image::Rgb<f32>> = (0..h).flat_map(|y| (0..w).map(move |x| image::Rgb(sky_texel(x, y).to_array()))).collect();
+    let pixels: Vec<image::Rgb<f32>> =
+        (0..h).flat_map(|y| (0..w).map(move |x| image::Rgb(sky_texel(x, y).to_array()))).collect();
     let file = std::fs::File::create(assets().join("sky.hdr")).unwrap();
     image::codecs::hdr::HdrEncoder::new(std::io::BufWriter::new(file)).encode(&pixels, w as usize, h as usize).unwrap();
 }
@@ -683,8 +728,10 @@ fn shipped_sky_matches_its_recipe() {
             let want = sky_texel(x, y);
             let got = Vec3::from(map.texels[(y * SKY_SIZE.0 + x) as usize]);
             // RGBE keeps 8 mantissa bits of the largest component.
-            assert!((got - want).abs().max_element() <= 0.01 * want.max_element() + 1e-6, "({x}, {y}): {got} vs {want}");
+            assert!(
+                (got - want).abs().max_element() <= 0.01 * want.max_element() + 1e-6,
+                "({x}, {y}): {got} vs {want}"
+            );
         }
     }
 }
-

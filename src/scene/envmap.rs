@@ -24,7 +24,11 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
     let format = match ext.as_str() {
         "hdr" => image::ImageFormat::Hdr,
         "exr" => image::ImageFormat::OpenExr,
-        _ => return Err(err(format!("unknown environment map format '.{ext}' (expected an equirectangular .hdr or .exr)"))),
+        _ => {
+            return Err(err(format!(
+                "unknown environment map format '.{ext}' (expected an equirectangular .hdr or .exr)"
+            )))
+        }
     };
     let file = std::fs::File::open(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => err("environment map not found".into()),
@@ -127,9 +131,9 @@ fn describe(e: &image::ImageError, format: image::ImageFormat) -> String {
             format!("truncated file ({text})")
         }
         // The exr crate names DWAA/DWAB in its errors when it meets a DWA variant it cannot decode.
-        _ if format == image::ImageFormat::OpenExr && lower.contains("dwa") => format!(
-            "cannot decode this DWAA/DWAB-compressed EXR ({text}); re-save it with ZIP or PIZ compression"
-        ),
+        _ if format == image::ImageFormat::OpenExr && lower.contains("dwa") => {
+            format!("cannot decode this DWAA/DWAB-compressed EXR ({text}); re-save it with ZIP or PIZ compression")
+        }
         image::ImageError::Unsupported(_) => format!("unsupported {} variant: {text}", name(format)),
         _ if format == image::ImageFormat::OpenExr && lower.contains("rgb channels") => {
             format!("no R, G, B channels found ({text}); an environment map needs an RGB(A) layer")
@@ -146,7 +150,8 @@ fn name(format: image::ImageFormat) -> &'static str {
     }
 }
 
-/// The direction a lat-long texture coordinate looks along (unit vector; before the renderer's rotation about +Y).
+/// The direction a lat-long texture coordinate looks along (unit vector), before the renderer's rotation about +Y
+/// (which adds `rotation` to φ; see `env_uv_to_direction` in `shaders/lights.wgsl`).
 ///
 /// `u ∈ [0,1]` runs left to right, `v ∈ [0,1]` top to bottom; with φ = 2π(u − ½) and θ = πv,
 /// `d = (sin θ sin φ, cos θ, −sin θ cos φ)`. So v = 0 is straight up (+Y), v = 1 straight down (−Y), the image
@@ -198,7 +203,8 @@ mod tests {
                 // And direction → uv → direction, scale-independent.
                 let d2 = equirect_direction(u2, v2);
                 assert!((d - d2).length() < 1e-4);
-                assert_eq!(direction_to_equirect(d * 3.0), (u2, v2));
+                let (u3, v3) = direction_to_equirect(d * 3.0);
+                assert!((u3 - u2).abs() < 1e-6 && (v3 - v2).abs() < 1e-6);
             }
         }
     }

@@ -263,7 +263,10 @@ impl Notes {
     }
     fn finish(mut self) -> Vec<String> {
         let counted = [
-            (self.skipped_primitives, "skipped point/line primitive(s) (POINTS, LINES, LINE_LOOP, LINE_STRIP): only triangles are rendered"),
+            (
+                self.skipped_primitives,
+                "skipped point/line primitive(s) (POINTS, LINES, LINE_LOOP, LINE_STRIP): only triangles are rendered",
+            ),
             (self.dropped_triangles, "dropped triangle(s) that use non-finite (NaN/Inf) vertex positions"),
             (self.repaired_normals, "zero or non-finite vertex normal(s) regenerated from the geometry"),
             (self.repaired_uvs, "non-finite texture coordinate(s) replaced with 0"),
@@ -279,7 +282,7 @@ impl Notes {
 // Accessors
 
 /// What an accessor is read for; decides the accepted type and component types.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 enum Usage {
     Position,
     Normal,
@@ -393,7 +396,7 @@ fn to_u32(b: &[u8], comp: ComponentType, _normalized: bool) -> u32 {
     }
 }
 
-/// Converts one element's components.
+/// Converts one component (the bytes start at it) of the given type to the output type.
 type Convert<T> = fn(&[u8], ComponentType, bool) -> T;
 
 // ---------------------------------------------------------------------------------------------------------
@@ -487,7 +490,8 @@ impl<'a> Loader<'a> {
     fn visit(&mut self, index: usize, parent: &Mat4, on_path: &mut [bool], depth: usize) -> Res<()> {
         let root = self.root;
         let count = root.nodes.len();
-        let node = root.nodes.get(index).ok_or_else(|| format!("node {index} does not exist (the file has {count} nodes)"))?;
+        let node =
+            root.nodes.get(index).ok_or_else(|| format!("node {index} does not exist (the file has {count} nodes)"))?;
         let label = format!("node {index}{}", quoted(&node.name));
         if on_path[index] {
             return Err(format!("{label} is its own ancestor: the node hierarchy contains a cycle"));
@@ -497,7 +501,9 @@ impl<'a> Loader<'a> {
         }
         self.visits += 1;
         if self.visits > MAX_NODE_VISITS {
-            return Err(format!("the scene expands to more than {MAX_NODE_VISITS} node instances (nodes shared by many parents?)"));
+            return Err(format!(
+                "the scene expands to more than {MAX_NODE_VISITS} node instances (nodes shared by many parents?)"
+            ));
         }
         let world = *parent * local_transform(node).map_err(|m| format!("{label}: {m}"))?;
         self.place_node(node, &label, &world)?;
@@ -513,7 +519,8 @@ impl<'a> Loader<'a> {
     fn place_node(&mut self, node: &json::Node, label: &str, world: &Mat4) -> Res<()> {
         if let Some(mesh) = node.mesh {
             if node.skin.is_some() {
-                self.notes.once("skin", || "skinning is ignored: skinned meshes are rendered in their bind pose".into());
+                self.notes
+                    .once("skin", || "skinning is ignored: skinned meshes are rendered in their bind pose".into());
             }
             self.place_mesh(mesh.value(), world)?;
         }
@@ -532,7 +539,10 @@ impl<'a> Loader<'a> {
     fn place_mesh(&mut self, mesh_index: usize, world: &Mat4) -> Res<()> {
         let root = self.root;
         let count = root.meshes.len();
-        let mesh = root.meshes.get(mesh_index).ok_or_else(|| format!("mesh {mesh_index} does not exist (the file has {count} meshes)"))?;
+        let mesh = root
+            .meshes
+            .get(mesh_index)
+            .ok_or_else(|| format!("mesh {mesh_index} does not exist (the file has {count} meshes)"))?;
         let name = mesh.name.clone().unwrap_or_else(|| format!("mesh {mesh_index}"));
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let what = format!("mesh '{name}' primitive {p}");
@@ -560,9 +570,11 @@ impl<'a> Loader<'a> {
         }
         let material = self.material(prim.material.map(|m| m.value()))?;
         let m = &self.scene.materials[material as usize];
-        let textured = m.base_color_texture.is_some() || m.metallic_roughness_texture.is_some() || m.emissive_texture.is_some();
+        let textured =
+            m.base_color_texture.is_some() || m.metallic_roughness_texture.is_some() || m.emissive_texture.is_some();
         if textured && geometry.uvs.is_empty() {
-            self.notes.push(format!("{what} has a textured material but no TEXCOORD_0; its textures are sampled at (0, 0)"));
+            self.notes
+                .push(format!("{what} has a textured material but no TEXCOORD_0; its textures are sampled at (0, 0)"));
         }
         let mesh = Mesh { name: name.to_string(), material, ..Default::default() };
         Ok(build_mesh(mesh, geometry, triangles, world, &mut self.notes))
@@ -616,7 +628,11 @@ impl<'a> Loader<'a> {
     fn read<T: Copy + Default>(&self, index: usize, usage: Usage, what: &str, convert: Convert<T>) -> Res<Vec<T>> {
         let label = format!("accessor {index} ({} of {what})", usage.name());
         let count_all = self.root.accessors.len();
-        let acc = self.root.accessors.get(index).ok_or_else(|| format!("{label} does not exist (the file has {count_all} accessors)"))?;
+        let acc = self
+            .root
+            .accessors
+            .get(index)
+            .ok_or_else(|| format!("{label} does not exist (the file has {count_all} accessors)"))?;
         self.read_checked(acc, usage, convert).map_err(|m| format!("{label}: {m}"))
     }
 
@@ -649,12 +665,19 @@ impl<'a> Loader<'a> {
     /// The bytes of buffer view `view` (checked against its buffer) and its byteStride.
     fn view(&self, view: usize) -> Res<(&[u8], Option<usize>)> {
         let views = &self.root.buffer_views;
-        let v = views.get(view).ok_or_else(|| format!("bufferView {view} does not exist (the file has {} bufferViews)", views.len()))?;
+        let v = views
+            .get(view)
+            .ok_or_else(|| format!("bufferView {view} does not exist (the file has {} bufferViews)", views.len()))?;
         let buffer = v.buffer.value();
-        let data = self.buffers.get(buffer).ok_or_else(|| format!("bufferView {view} names buffer {buffer}, which does not exist"))?;
+        let data = self
+            .buffers
+            .get(buffer)
+            .ok_or_else(|| format!("bufferView {view} names buffer {buffer}, which does not exist"))?;
         let (start, len) = (v.byte_offset.map_or(0, |o| o.0), v.byte_length.0);
         match start.checked_add(len) {
-            Some(end) if end <= data.len() as u64 => Ok((&data[start as usize..end as usize], v.byte_stride.map(|s| s.0))),
+            Some(end) if end <= data.len() as u64 => {
+                Ok((&data[start as usize..end as usize], v.byte_stride.map(|s| s.0)))
+            }
             _ => Err(format!(
                 "bufferView {view} (bytes {start}..{}) extends past the end of buffer {buffer} ({} bytes)",
                 start.saturating_add(len),
@@ -674,7 +697,8 @@ impl<'a> Loader<'a> {
             return Ok(Layout { bytes: &[], stride, elem });
         }
         let len = bytes.len() as u64;
-        let need = (stride as u64).checked_mul(count as u64 - 1).and_then(|x| x.checked_add(elem as u64)?.checked_add(offset));
+        let need =
+            (stride as u64).checked_mul(count as u64 - 1).and_then(|x| x.checked_add(elem as u64)?.checked_add(offset));
         match need {
             Some(need) if need <= len => Ok(Layout { bytes: &bytes[offset as usize..need as usize], stride, elem }),
             _ => Err(format!(
@@ -700,8 +724,12 @@ impl<'a> Loader<'a> {
             return Err("sparse indices have an invalid componentType".into());
         };
         let (ind, val) = (&sparse.indices, &sparse.values);
-        let indices = self.layout(ind.buffer_view.value(), ind.byte_offset.0, k as usize, icomp.size()).map_err(|m| format!("sparse indices: {m}"))?;
-        let values = self.layout(val.buffer_view.value(), val.byte_offset.0, k as usize, comp.size() * n).map_err(|m| format!("sparse values: {m}"))?;
+        let indices = self
+            .layout(ind.buffer_view.value(), ind.byte_offset.0, k as usize, icomp.size())
+            .map_err(|m| format!("sparse indices: {m}"))?;
+        let values = self
+            .layout(val.buffer_view.value(), val.byte_offset.0, k as usize, comp.size() * n)
+            .map_err(|m| format!("sparse values: {m}"))?;
         for j in 0..k as usize {
             let i = to_u32(indices.element(j), icomp, false) as usize;
             if i >= count {
@@ -735,7 +763,10 @@ impl<'a> Loader<'a> {
     fn convert_material(&mut self, index: usize) -> Res<Material> {
         let root = self.root;
         let count = root.materials.len();
-        let m = root.materials.get(index).ok_or_else(|| format!("material {index} does not exist (the file has {count} materials)"))?;
+        let m = root
+            .materials
+            .get(index)
+            .ok_or_else(|| format!("material {index} does not exist (the file has {count} materials)"))?;
         let label = format!("material {index}{}", quoted(&m.name));
         let mut material = material_factors(m, &label, &mut self.notes);
         let pbr = &m.pbr_metallic_roughness;
@@ -745,8 +776,18 @@ impl<'a> Loader<'a> {
         if material.emission.max_element() > 0.0 {
             material.emissive_texture = self.texture_opt(&m.emissive_texture, true, &label)?;
         }
+        let specular = m.extensions.as_ref().and_then(|e| e.specular.as_ref());
+        if specular.is_some_and(|s| {
+            s.specular_texture.is_some() || s.specular_color_texture.is_some() || s.specular_color_factor.0 != [1.0; 3]
+        }) {
+            self.notes.once("specular", || {
+                format!("KHR_materials_specular colour and textures are ignored; only specularFactor is used ({label})")
+            });
+        }
         if m.alpha_mode != Checked::Valid(json::material::AlphaMode::Opaque) {
-            self.notes.once("alpha", || format!("{label}: alphaMode MASK/BLEND is ignored (surfaces are rendered opaque)"));
+            self.notes.once("alpha", || {
+                format!("alphaMode MASK/BLEND is ignored: surfaces are rendered opaque (first seen in {label})")
+            });
         }
         Ok(material)
     }
@@ -760,7 +801,10 @@ impl<'a> Loader<'a> {
         let root = self.root;
         let ti = info.index.value();
         let count = root.textures.len();
-        let texture = root.textures.get(ti).ok_or_else(|| format!("{label}: texture {ti} does not exist (the file has {count} textures)"))?;
+        let texture = root
+            .textures
+            .get(ti)
+            .ok_or_else(|| format!("{label}: texture {ti} does not exist (the file has {count} textures)"))?;
         let (wrap_s, wrap_t, nearest) = self.sampler(texture.sampler, label)?;
         let image = texture.source.value();
         let key = (image, wrap_s as u8, wrap_t as u8, nearest, srgb);
@@ -783,7 +827,9 @@ impl<'a> Loader<'a> {
             texcoord = t.tex_coord.unwrap_or(texcoord);
         }
         if texcoord != 0 {
-            self.notes.once("texcoord", || format!("{label}: a texture uses TEXCOORD_{texcoord}; only TEXCOORD_0 is loaded and is used instead"));
+            self.notes.once("texcoord", || {
+                format!("{label}: a texture uses TEXCOORD_{texcoord}; only TEXCOORD_0 is loaded and is used instead")
+            });
         }
         Ok(reference)
     }
@@ -791,7 +837,11 @@ impl<'a> Loader<'a> {
     fn sampler(&self, sampler: Option<json::Index<json::texture::Sampler>>, label: &str) -> Res<(Wrap, Wrap, bool)> {
         let Some(index) = sampler.map(|s| s.value()) else { return Ok((Wrap::Repeat, Wrap::Repeat, false)) };
         let count = self.root.samplers.len();
-        let s = self.root.samplers.get(index).ok_or_else(|| format!("{label}: sampler {index} does not exist (the file has {count} samplers)"))?;
+        let s = self
+            .root
+            .samplers
+            .get(index)
+            .ok_or_else(|| format!("{label}: sampler {index} does not exist (the file has {count} samplers)"))?;
         let nearest = s.mag_filter == Some(Checked::Valid(json::texture::MagFilter::Nearest));
         Ok((wrap(s.wrap_s), wrap(s.wrap_t), nearest))
     }
@@ -803,7 +853,10 @@ impl<'a> Loader<'a> {
         }
         let root = self.root;
         let count = root.images.len();
-        let image = root.images.get(index).ok_or_else(|| format!("{label}: image {index} does not exist (the file has {count} images)"))?;
+        let image = root
+            .images
+            .get(index)
+            .ok_or_else(|| format!("{label}: image {index} does not exist (the file has {count} images)"))?;
         let what = format!("image {index} ({})", image_name(root, index));
         let bytes = match (&image.uri, image.buffer_view) {
             (Some(uri), _) => fetch_uri(self.base, uri),
@@ -821,7 +874,11 @@ impl<'a> Loader<'a> {
     /// A perspective camera at the node's world transform; None (with a warning) when it cannot be used.
     fn camera(&mut self, index: usize, world: &Mat4) -> Res<Option<Camera>> {
         let count = self.root.cameras.len();
-        let camera = self.root.cameras.get(index).ok_or_else(|| format!("camera {index} does not exist (the file has {count} cameras)"))?;
+        let camera = self
+            .root
+            .cameras
+            .get(index)
+            .ok_or_else(|| format!("camera {index} does not exist (the file has {count} cameras)"))?;
         let label = format!("camera {index}{}", quoted(&camera.name));
         let perspective = match (camera.type_, &camera.perspective) {
             (Checked::Valid(json::camera::Type::Perspective), Some(p)) => p,
@@ -848,7 +905,9 @@ impl<'a> Loader<'a> {
     fn light(&mut self, index: usize, world: &Mat4, node: &str) -> Res<()> {
         let lights = self.root.extensions.as_ref().and_then(|e| e.khr_lights_punctual.as_ref());
         let lights = lights.map_or(&[][..], |l| &l.lights[..]);
-        let light = lights.get(index).ok_or_else(|| format!("{node}: KHR_lights_punctual light {index} does not exist (the file has {})", lights.len()))?;
+        let light = lights.get(index).ok_or_else(|| {
+            format!("{node}: KHR_lights_punctual light {index} does not exist (the file has {})", lights.len())
+        })?;
         let label = format!("{node}: light {index}{}", quoted(&light.name));
         let power = Vec3::from(light.color) * light.intensity;
         let position = world.transform_point3(Vec3::ZERO);
@@ -882,7 +941,11 @@ impl<'a> Loader<'a> {
     fn cone(&mut self, spot: Option<&punctual::Spot>, label: &str) -> (f32, f32) {
         let quarter = std::f32::consts::FRAC_PI_4;
         let (inner, outer) = spot.map_or((0.0, quarter), |s| (s.inner_cone_angle, s.outer_cone_angle));
-        let valid = inner.is_finite() && outer.is_finite() && inner >= 0.0 && inner < outer && outer <= std::f32::consts::FRAC_PI_2;
+        let valid = inner.is_finite()
+            && outer.is_finite()
+            && inner >= 0.0
+            && inner < outer
+            && outer <= std::f32::consts::FRAC_PI_2;
         if valid {
             return (inner, outer);
         }
@@ -907,7 +970,9 @@ impl<'a> Loader<'a> {
 fn same_count<T>(values: Vec<T>, n: usize, accessor: usize, semantic: &str, what: &str) -> Res<Vec<T>> {
     if values.len() != n {
         let got = values.len();
-        return Err(format!("accessor {accessor} ({semantic} of {what}): count {got} differs from the POSITION count {n}"));
+        return Err(format!(
+            "accessor {accessor} ({semantic} of {what}): count {got} differs from the POSITION count {n}"
+        ));
     }
     Ok(values)
 }
@@ -951,7 +1016,13 @@ fn assemble(mode: Mode, idx: &[u32]) -> (Vec<[u32; 3]>, usize) {
 
 /// Transforms a primitive to world space, fixes winding for mirrors, drops non-finite triangles and makes
 /// every normal unit length. None when no triangle survives.
-fn build_mesh(mut mesh: Mesh, geo: Geometry, mut triangles: Vec<[u32; 3]>, world: &Mat4, notes: &mut Notes) -> Option<Mesh> {
+fn build_mesh(
+    mut mesh: Mesh,
+    geo: Geometry,
+    mut triangles: Vec<[u32; 3]>,
+    world: &Mat4,
+    notes: &mut Notes,
+) -> Option<Mesh> {
     let linear = Mat3::from_mat4(*world);
     let det = linear.determinant();
     if det < 0.0 {
@@ -1031,7 +1102,11 @@ fn material_factors(m: &json::Material, label: &str, notes: &mut Notes) -> Mater
     let mut repaired = false;
     let mut clean = |x: f32, lo: f32, hi: f32, default: f32| {
         repaired |= !x.is_finite();
-        if x.is_finite() { x.clamp(lo, hi) } else { default }
+        if x.is_finite() {
+            x.clamp(lo, hi)
+        } else {
+            default
+        }
     };
     let pbr = &m.pbr_metallic_roughness;
     let [r, g, b, _alpha] = pbr.base_color_factor.0;
@@ -1089,7 +1164,9 @@ fn decode_image(bytes: &[u8]) -> Res<Decoded> {
     let reader = || image::ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string());
     let (width, height) = reader()?.into_dimensions().map_err(|e| format!("cannot decode the image: {e}"))?;
     if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
-        return Err(format!("{width}×{height} texels exceeds the texture size limit of {MAX_TEXTURE_SIZE} texels per side"));
+        return Err(format!(
+            "{width}×{height} texels exceeds the texture size limit of {MAX_TEXTURE_SIZE} texels per side"
+        ));
     }
     let image = reader()?.decode().map_err(|e| format!("cannot decode the image: {e}"))?;
     let rgba = image.to_rgba8();

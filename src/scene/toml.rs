@@ -242,7 +242,11 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
     let lookup = |span: &dyn Fn(&str) -> SceneError, name: &str| -> Result<u32, SceneError> {
         material_index.get(name).copied().ok_or_else(|| {
             let known: Vec<&str> = material_index.keys().copied().collect();
-            let known = if known.is_empty() { "none are defined".to_string() } else { format!("defined: {}", known.join(", ")) };
+            let known = if known.is_empty() {
+                "none are defined".to_string()
+            } else {
+                format!("defined: {}", known.join(", "))
+            };
             span(&format!("unknown material '{name}' ({known})"))
         })
     };
@@ -276,7 +280,9 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
         let e = |m: &str| ctx.err(r, format!("[[rectangle]] {}: {m}", i + 1));
         let d = r.get_ref();
         let center = finite_vec(d.center).ok_or_else(|| e("center must be finite"))?;
-        let normal = finite_vec(d.normal).and_then(Vec3::try_normalize).ok_or_else(|| e("normal must be a finite non-zero vector"))?;
+        let normal = finite_vec(d.normal)
+            .and_then(Vec3::try_normalize)
+            .ok_or_else(|| e("normal must be a finite non-zero vector"))?;
         let [w, h] = d.size.0;
         if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
             return Err(e("size must be positive and finite"));
@@ -287,7 +293,8 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
             None if normal.x.abs() < 0.9 => Vec3::X,
             None => Vec3::Z,
         };
-        let tangent = (hint - normal * hint.dot(normal)).try_normalize().ok_or_else(|| e("u_axis is parallel to the normal"))?;
+        let tangent =
+            (hint - normal * hint.dot(normal)).try_normalize().ok_or_else(|| e("u_axis is parallel to the normal"))?;
         // bitangent = normal × tangent makes tangent × bitangent = normal: the front faces along `normal`.
         let (edge_u, edge_v) = (tangent * w, normal.cross(tangent) * h);
         let material = lookup(&e, &d.material)?;
@@ -297,7 +304,12 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
     for (i, m) in file.mesh.iter().enumerate() {
         let e = |msg: &str| ctx.err(m, format!("[[mesh]] {}: {msg}", i + 1));
         let d = m.get_ref();
-        let positions: Vec<Vec3> = d.positions.iter().map(|p| finite_vec(*p)).collect::<Option<_>>().ok_or_else(|| e("positions must be finite"))?;
+        let positions: Vec<Vec3> = d
+            .positions
+            .iter()
+            .map(|p| finite_vec(*p))
+            .collect::<Option<_>>()
+            .ok_or_else(|| e("positions must be finite"))?;
         if d.indices.is_empty() {
             return Err(e("no triangles (indices is empty)"));
         }
@@ -352,8 +364,12 @@ fn camera(ctx: &Ctx, c: &Spanned<CameraDef>) -> Result<Camera, SceneError> {
         (None, Some(f)) => finite_vec(f),
         (None, None) => Some(Vec3::NEG_Z),
     };
-    let forward = forward.and_then(Vec3::try_normalize).ok_or_else(|| e("the viewing direction is zero or not finite (look_at equals position?)"))?;
-    let up = finite_vec(d.up.unwrap_or([0.0, 1.0, 0.0])).and_then(Vec3::try_normalize).ok_or_else(|| e("up must be a finite non-zero vector"))?;
+    let forward = forward
+        .and_then(Vec3::try_normalize)
+        .ok_or_else(|| e("the viewing direction is zero or not finite (look_at equals position?)"))?;
+    let up = finite_vec(d.up.unwrap_or([0.0, 1.0, 0.0]))
+        .and_then(Vec3::try_normalize)
+        .ok_or_else(|| e("up must be a finite non-zero vector"))?;
     if forward.cross(up).length_squared() < 1e-8 {
         return Err(e("up is parallel to the viewing direction"));
     }
@@ -364,7 +380,12 @@ fn camera(ctx: &Ctx, c: &Spanned<CameraDef>) -> Result<Camera, SceneError> {
     Ok(Camera { position, forward, up, vfov: vfov.to_radians() })
 }
 
-fn material(ctx: &Ctx, name: &str, def: &Spanned<MaterialDef>, warnings: &mut Vec<String>) -> Result<Material, SceneError> {
+fn material(
+    ctx: &Ctx,
+    name: &str,
+    def: &Spanned<MaterialDef>,
+    warnings: &mut Vec<String>,
+) -> Result<Material, SceneError> {
     let e = |m: &str| ctx.err(def, format!("material '{name}': {m}"));
     let d = def.get_ref();
     // Which keys each type takes; anything else given is an error rather than silently ignored.
@@ -382,7 +403,11 @@ fn material(ctx: &Ctx, name: &str, def: &Spanned<MaterialDef>, warnings: &mut Ve
         "conductor" => &["reflectance", "alpha", "emission"],
         "metallic-roughness" => &["base_color", "metallic", "roughness", "specular", "emission"],
         "emitter" => &["emission"],
-        other => return Err(e(&format!("unknown type \"{other}\" (expected lambert, conductor, metallic-roughness or emitter)"))),
+        other => {
+            return Err(e(&format!(
+                "unknown type \"{other}\" (expected lambert, conductor, metallic-roughness or emitter)"
+            )))
+        }
     };
     if let Some((key, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
         return Err(e(&format!("type \"{}\" does not take '{key}' (it takes: {})", d.kind, allowed.join(", "))));
@@ -405,7 +430,11 @@ fn material(ctx: &Ctx, name: &str, def: &Spanned<MaterialDef>, warnings: &mut Ve
     let mut m = match d.kind.as_str() {
         "lambert" => Material::lambert(name, color("reflectance", d.reflectance, 0.8)?),
         "conductor" => {
-            let alpha = unit("alpha", Some(d.alpha.ok_or_else(|| e("type \"conductor\" needs 'alpha' (GGX α = roughness²)"))?), 0.0)?;
+            let alpha = unit(
+                "alpha",
+                Some(d.alpha.ok_or_else(|| e("type \"conductor\" needs 'alpha' (GGX α = roughness²)"))?),
+                0.0,
+            )?;
             Material::conductor(name, color("reflectance", d.reflectance, 1.0)?, alpha)
         }
         "metallic-roughness" => Material {
@@ -452,14 +481,22 @@ fn light(ctx: &Ctx, i: usize, l: &Spanned<LightDef>) -> Result<PunctualLight, Sc
         "spot" => &["position", "direction", "intensity", "inner_cone", "outer_cone"],
         "directional" => &["direction", "irradiance"],
         other => {
-            return Err(ctx.err(l, format!("[[light]] {}: unknown type \"{other}\" (expected point, spot or directional)", i + 1)));
+            return Err(ctx.err(
+                l,
+                format!("[[light]] {}: unknown type \"{other}\" (expected point, spot or directional)", i + 1),
+            ));
         }
     };
     if let Some((key, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
         return Err(e(&format!("does not take '{key}' (it takes: {})", allowed.join(", "))));
     }
     let position = || d.position.and_then(finite_vec).ok_or_else(|| e("needs a finite 'position'"));
-    let direction = || d.direction.and_then(finite_vec).and_then(Vec3::try_normalize).ok_or_else(|| e("needs a finite non-zero 'direction'"));
+    let direction = || {
+        d.direction
+            .and_then(finite_vec)
+            .and_then(Vec3::try_normalize)
+            .ok_or_else(|| e("needs a finite non-zero 'direction'"))
+    };
     let power = |key: &str, v: Option<Splat<3>>| -> Result<Vec3, SceneError> {
         let c = v.map(|s| Vec3::from(s.0)).ok_or_else(|| e(&format!("needs '{key}'")))?;
         if !c.is_finite() || c.min_element() < 0.0 {
@@ -519,7 +556,13 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDef>) -> Result<(Environment,
 }
 
 /// Loads a glTF include, transforms it into place and merges it into `scene`.
-fn include(ctx: &Ctx, i: usize, inc: &Spanned<IncludeDef>, options: &LoadOptions, scene: &mut Scene) -> Result<(), SceneError> {
+fn include(
+    ctx: &Ctx,
+    i: usize,
+    inc: &Spanned<IncludeDef>,
+    options: &LoadOptions,
+    scene: &mut Scene,
+) -> Result<(), SceneError> {
     let d = inc.get_ref();
     let e = |m: &str| ctx.err(inc, format!("[[include]] {} ('{}'): {m}", i + 1, d.gltf));
 
@@ -532,18 +575,25 @@ fn include(ctx: &Ctx, i: usize, inc: &Spanned<IncludeDef>, options: &LoadOptions
     let rotation = match &d.rotate {
         None => Quat::IDENTITY,
         Some(RotateDef { axis: Some(axis), angle: Some(angle), euler: None }) => {
-            let axis = finite_vec(*axis).and_then(Vec3::try_normalize).ok_or_else(|| e("rotate.axis must be a finite non-zero vector"))?;
+            let axis = finite_vec(*axis)
+                .and_then(Vec3::try_normalize)
+                .ok_or_else(|| e("rotate.axis must be a finite non-zero vector"))?;
             if !angle.is_finite() {
                 return Err(e("rotate.angle must be finite"));
             }
             Quat::from_axis_angle(axis, angle.to_radians())
         }
         Some(RotateDef { axis: None, angle: None, euler: Some(xyz) }) => {
-            let [x, y, z] = finite_vec(*xyz).ok_or_else(|| e("rotate.euler must be finite"))?.to_array().map(f32::to_radians);
+            let [x, y, z] =
+                finite_vec(*xyz).ok_or_else(|| e("rotate.euler must be finite"))?.to_array().map(f32::to_radians);
             // About the fixed world axes, X first, then Y, then Z.
             Quat::from_rotation_z(z) * Quat::from_rotation_y(y) * Quat::from_rotation_x(x)
         }
-        Some(_) => return Err(e("rotate needs either { axis = [x, y, z], angle = degrees } or { euler = [x, y, z] } (degrees)")),
+        Some(_) => {
+            return Err(e(
+                "rotate needs either { axis = [x, y, z], angle = degrees } or { euler = [x, y, z] } (degrees)",
+            ))
+        }
     };
     let matrix = Mat4::from_scale_rotation_translation(scale, rotation, translate);
 
@@ -551,7 +601,9 @@ fn include(ctx: &Ctx, i: usize, inc: &Spanned<IncludeDef>, options: &LoadOptions
     if !path.is_file() {
         return Err(e(&format!("glTF file {} not found", path.display())));
     }
-    let options = LoadOptions { gltf_scene: d.scene, ..options.clone() };
+    // The include's own `scene` (not the command line's --gltf-scene, which is for a top-level glTF file).
+    let mut options = options.clone();
+    options.gltf_scene = d.scene;
     // Contain loader panics here too, so the message says which include broke.
     let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| super::gltf::load(&path, &options)))
         .map_err(|_| e("the glTF loader failed on this file (malformed?)"))?
@@ -624,7 +676,10 @@ fn merge(scene: &mut Scene, other: Scene, use_camera: bool) {
     let material_offset = scene.materials.len() as u32;
     let texture_offset = scene.textures.len() as u32;
     for mut m in other.materials {
-        for t in [&mut m.base_color_texture, &mut m.metallic_roughness_texture, &mut m.emissive_texture].into_iter().flatten() {
+        for t in [&mut m.base_color_texture, &mut m.metallic_roughness_texture, &mut m.emissive_texture]
+            .into_iter()
+            .flatten()
+        {
             t.texture += texture_offset;
         }
         scene.materials.push(m);

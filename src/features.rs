@@ -1,0 +1,192 @@
+//! Features: what a scene uses, derived from its flattened data, and the pipeline constants that compile
+//! out everything else. `Settings` decide which techniques run; `Features` decide which code exists.
+
+use crate::gpu_scene::SceneData;
+use crate::gpu_types::*;
+use crate::settings::Settings;
+
+/// What kind of environment the scene has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EnvKind {
+    /// Black.
+    None = 0,
+    /// Constant radiance.
+    Constant = 1,
+    /// Equirectangular map.
+    Map = 2,
+    /// Decided at run time (the generic pipeline).
+    Any = 3,
+}
+
+/// The scene's features. `Features::generic()` has everything on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Features {
+    /// Triangles in the BVH.
+    pub triangles: bool,
+    /// Analytic spheres.
+    pub spheres: bool,
+    /// Analytic quads.
+    pub quads: bool,
+    /// Emissive triangles.
+    pub triangle_lights: bool,
+    /// Emissive spheres.
+    pub sphere_lights: bool,
+    /// Emissive quads.
+    pub quad_lights: bool,
+    /// Point, spot or directional lights.
+    pub delta_lights: bool,
+    /// Environment kind.
+    pub env: EnvKind,
+    /// Any texture.
+    pub textures: bool,
+    /// Any material with a GGX lobe.
+    pub specular: bool,
+    /// Any material with a diffuse lobe.
+    pub diffuse: bool,
+    /// More than one entry in the light table (light selection needed).
+    pub many_lights: bool,
+}
+
+impl Features {
+    /// Everything compiled in.
+    pub fn generic() -> Features {
+        Features {
+            triangles: true,
+            spheres: true,
+            quads: true,
+            triangle_lights: true,
+            sphere_lights: true,
+            quad_lights: true,
+            delta_lights: true,
+            env: EnvKind::Any,
+            textures: true,
+            specular: true,
+            diffuse: true,
+            many_lights: true,
+        }
+    }
+
+    /// What `data` needs.
+    pub fn of(data: &SceneData) -> Features {
+        let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
+        let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
+            (false, _) => EnvKind::None,
+            (true, false) => EnvKind::Constant,
+            (true, true) => EnvKind::Map,
+        };
+        Features {
+            triangles: !data.tri_shading.is_empty(),
+            spheres: !data.spheres.is_empty(),
+            quads: !data.quads.is_empty(),
+            triangle_lights: kinds(LIGHT_TRIANGLE),
+            sphere_lights: kinds(LIGHT_SPHERE),
+            quad_lights: kinds(LIGHT_QUAD),
+            delta_lights: kinds(LIGHT_POINT) || kinds(LIGHT_SPOT) || kinds(LIGHT_DIRECTIONAL),
+            env,
+            textures: !data.tex_info.is_empty(),
+            specular: data.materials.iter().any(|m| m.metallic > 0.0 || m.specular > 0.0),
+            diffuse: data.materials.iter().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
+            many_lights: data.lights.len() > 1,
+        }
+    }
+
+    /// The WGSL override constants for these features.
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        let b = |x: bool| if x { 1.0 } else { 0.0 };
+        vec![
+            ("HAS_TRIANGLES", b(self.triangles)),
+            ("HAS_SPHERES", b(self.spheres)),
+            ("HAS_QUADS", b(self.quads)),
+            ("HAS_TRIANGLE_LIGHTS", b(self.triangle_lights)),
+            ("HAS_SPHERE_LIGHTS", b(self.sphere_lights)),
+            ("HAS_QUAD_LIGHTS", b(self.quad_lights)),
+            ("HAS_DELTA_LIGHTS", b(self.delta_lights)),
+            ("ENV_KIND", self.env as u32 as f64),
+            ("HAS_TEXTURES", b(self.textures)),
+            ("HAS_SPECULAR", b(self.specular)),
+            ("HAS_DIFFUSE", b(self.diffuse)),
+            ("MANY_LIGHTS", b(self.many_lights)),
+        ]
+    }
+
+    /// Human-readable list of the code paths compiled in (for `mislab info`).
+    pub fn describe(&self) -> String {
+        let mut v = vec![];
+        let mut on = |name: &str, x: bool| {
+            if x {
+                v.push(name.to_string())
+            }
+        };
+        on("triangles", self.triangles);
+        on("spheres", self.spheres);
+        on("quads", self.quads);
+        on("triangle lights", self.triangle_lights);
+        on("sphere lights", self.sphere_lights);
+        on("quad lights", self.quad_lights);
+        on("point/spot/directional lights", self.delta_lights);
+        on("textures", self.textures);
+        on("GGX lobe", self.specular);
+        on("diffuse lobe", self.diffuse);
+        on("light selection", self.many_lights);
+        v.push(format!("environment: {:?}", self.env).to_lowercase());
+        v.join(", ")
+    }
+}
+
+/// Which pipeline to build: the scene's features, and the settings fixed at compile time (None = read at
+/// run time from the uniform, for the viewer's generic pipeline).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineKey {
+    /// Scene features.
+    pub features: Features,
+    /// Fixed estimator choices, or dynamic.
+    pub fixed: Option<FixedSettings>,
+}
+
+/// The enum-valued settings a specialised pipeline fixes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FixedSettings {
+    /// Tags, in the order of the `SPEC_*` constants.
+    pub tags: [u32; 8],
+}
+
+/// Names of the settings constants, in `FixedSettings::tags` order.
+pub const SETTINGS_CONSTANTS: [&str; 8] =
+    ["SPEC_MODE", "SPEC_STRATEGY", "SPEC_LIGHT_SAMPLING", "SPEC_ENV_SAMPLING", "SPEC_LIGHT_SELECT", "SPEC_HEURISTIC", "SPEC_MIS_KIND", "SPEC_SAMPLER"];
+
+impl FixedSettings {
+    /// The enum choices of `s`.
+    pub fn of(s: &Settings) -> FixedSettings {
+        FixedSettings {
+            tags: [
+                s.mode.tag(),
+                s.strategy.tag(),
+                s.light_sampling.tag(),
+                s.env_sampling.tag(),
+                s.light_select.tag(),
+                s.heuristic.tag(),
+                s.mis.tag(),
+                s.sampler.tag(),
+            ],
+        }
+    }
+}
+
+impl PipelineKey {
+    /// Fully specialised to a scene and settings.
+    pub fn specialized(features: Features, settings: &Settings) -> PipelineKey {
+        PipelineKey { features, fixed: Some(FixedSettings::of(settings)) }
+    }
+    /// Everything decided at run time.
+    pub fn generic() -> PipelineKey {
+        PipelineKey { features: Features::generic(), fixed: None }
+    }
+    /// All override constants of this key.
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        let mut c = self.features.constants();
+        if let Some(f) = self.fixed {
+            c.extend(SETTINGS_CONSTANTS.iter().zip(f.tags).map(|(n, t)| (*n, t as f64)));
+        }
+        c
+    }
+}
