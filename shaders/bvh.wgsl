@@ -66,16 +66,16 @@ fn ray_box_entry(r: TraceRay, bmin: vec3<f32>, bmax: vec3<f32>, t_far: f32) -> f
 
 /// One edge function of the watertight test, U/V/W = p.x·q.y − p.y·q.x in the sheared 2D frame. The paper
 /// re-evaluates an exact 0 in double precision so that adjacent triangles agree on its sign; we instead evaluate
-/// every edge with its endpoints in a canonical (lexicographic) order and negate afterwards. The two triangles
-/// sharing an edge then compute bit-identical values with opposite signs whatever the compiler does (lavapipe
-/// reassociates and contracts to fma, which breaks the paper's assumption that e(p,q) = −e(q,p) in floats), so
-/// a ray through the edge hits at least one of them; a value of exactly 0 counts as inside for both (a tie, not a
-/// hole). No f64 needed.
+/// every edge with its endpoints in a canonical (lexicographic) order and negate afterwards. WGSL lets a compiler
+/// reassociate or contract a·b − c·d into an fma, after which e(p,q) = −e(q,p) no longer holds bit for bit; with
+/// the canonical order the two triangles sharing an edge compute the same bits with opposite signs whatever the
+/// compiler does, so a ray through the edge hits at least one of them. A value of exactly 0 counts as inside for
+/// both (a tie, never a hole). No f64 needed.
 fn tri_edge(p: vec2<f32>, q: vec2<f32>) -> f32 {
     let swap = q.x < p.x || (q.x == p.x && q.y < p.y);
     let a = select(p, q, swap);
     let b = select(q, p, swap);
-    let e = fma(a.x, b.y, -(a.y * b.x));
+    let e = a.x * b.y - a.y * b.x;
     return select(e, -e, swap);
 }
 

@@ -23,7 +23,9 @@ fn light_pmf(i: u32) -> f32 {
     return select(l.pmf_uniform, l.pmf_power, cfg_light_select() == LIGHT_SELECT_POWER);
 }
 
-/// Samples an index from an alias table of `n` entries starting at `base` with one number u.
+/// Samples an index from an alias table of `n` entries starting at `base` with one number u: the column from
+/// u·n, the coin from its fractional part. NOTE: u has 24 random bits (samplers.wgsl), so the coin keeps only
+/// 24 − log2(n) of them; use `alias_sample2` where a second number is available (large tables).
 fn alias_sample(base: u32, n: u32, u: f32, table_is_env: bool) -> u32 {
     let x = u * f32(n);
     let i = min(u32(x), n - 1u);
@@ -31,6 +33,21 @@ fn alias_sample(base: u32, n: u32, u: f32, table_is_env: bool) -> u32 {
     var e: AliasEntry;
     if (table_is_env) { e = env_alias[base + i]; } else { e = light_alias[base + i]; }
     return select(e.alias_index, i, r < e.prob);
+}
+
+/// Alias-table sampling with separate numbers for the column (`u_col`) and the coin (`u_coin`), so the coin has
+/// full precision for any table size. Returns the index and `u_coin` rescaled to [0, 1) within the branch taken,
+/// for reuse (Vose 1991; the rescaling is pbrt-v4's AliasTable::Sample).
+struct AliasPick {
+    index: u32,
+    u: f32,
+}
+fn alias_sample2(base: u32, n: u32, u_col: f32, u_coin: f32, table_is_env: bool) -> AliasPick {
+    let i = min(u32(u_col * f32(n)), n - 1u);
+    var e: AliasEntry;
+    if (table_is_env) { e = env_alias[base + i]; } else { e = light_alias[base + i]; }
+    if (u_coin < e.prob) { return AliasPick(i, min(u_coin / e.prob, ONE_MINUS_EPSILON)); }
+    return AliasPick(e.alias_index, min((u_coin - e.prob) / (1.0 - e.prob), ONE_MINUS_EPSILON));
 }
 
 /// Chooses one light with probability `light_pmf`.
@@ -82,8 +99,9 @@ fn quad_sample_li(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted);
 }
 
-/// Sphere light, uniform by area over the whole sphere (points on the far side are occluded by the
-/// sphere itself, which the shadow ray finds). Measure: area → solid angle.
+/// Sphere light, uniform by area over the whole sphere. Points on the far side face away from p and come back
+/// as failed samples (pdf 0), so the pdf of the successful ones integrates to the visible fraction of the area.
+/// Measure: area → solid angle.
 fn sphere_sample_li_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let s = spheres[prim];
     let n = square_to_uniform_sphere(u);
@@ -114,8 +132,9 @@ fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let f = frame_from_normal(to_c / d);
     let wl = square_to_uniform_cone(u, omc);
     let wi = normalize(to_world(f, wl));
-    // Distance along wi to the near intersection: t = d·cosθ − sqrt(r² − d²·sin²θ).
-    let sin2 = max(1.0 - wl.z * wl.z, 0.0);
+    // Distance along wi to the near intersection: t = d·cosθ − sqrt(r² − d²·sin²θ). sin²θ from the transverse
+    // components (1 − z² has no digits left in a tiny cone).
+    let sin2 = wl.x * wl.x + wl.y * wl.y;
     let cos_t = wl.z;
     let t = max(d * cos_t - safe_sqrt(s.radius * s.radius - d * d * sin2), 0.0);
     let y = p + t * wi;
@@ -123,6 +142,103 @@ fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
     let emitted = material_emission(materials[s.material], uv);
     return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), false);
+}
+
+// ---- triangle and quad lights by solid angle (spherical triangle / spherical rectangle) ----
+//
+// Fallback to area sampling, a deterministic function of (light, shading point) shared by sample_li and pdf_li:
+// the spherical warps are used only where their f32 error is small, measured against an f64 reference on this
+// device (tests/sampling.rs, `spherical_warps_precision`; table in docs/sampling.md). Below the minimum solid
+// angle the polygon is small and area sampling is nearly as good (its pdf is nearly constant over the light).
+
+/// Spherical-triangle sampling is used for triangles subtending [SPHERICAL_TRIANGLE_MIN_SR, SPHERICAL_TRIANGLE_MAX_SR].
+const SPHERICAL_TRIANGLE_MIN_SR: f32 = 1e-5;
+const SPHERICAL_TRIANGLE_MAX_SR: f32 = 6.2;
+/// Spherical-rectangle sampling is used for rectangles subtending [SPHERICAL_RECT_MIN_SR, SPHERICAL_RECT_MAX_SR].
+const SPHERICAL_RECT_MIN_SR: f32 = 1e-5;
+const SPHERICAL_RECT_MAX_SR: f32 = 6.2;
+/// A quad is a rectangle when |cos| of the angle between its edges is at most this; other parallelograms are
+/// sampled by area in either mode.
+const RECT_COS_TOLERANCE: f32 = 1e-5;
+
+/// Solid angle of triangle light `prim` as its solid-angle sampler uses it: Ω > 0 when spherical sampling
+/// applies, −1 when p is in front but area sampling is used (Ω out of range), 0 when p sees its back or lies in
+/// its plane (no light reaches p).
+fn triangle_light_omega(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32>) -> f32 {
+    let n = cross(v1 - v0, v2 - v0);
+    if (!(dot(p - v0, n) > 0.0)) { return 0.0; }
+    let omega = spherical_triangle_solid_angle(v0 - p, v1 - p, v2 - p);
+    if (omega >= SPHERICAL_TRIANGLE_MIN_SR && omega <= SPHERICAL_TRIANGLE_MAX_SR) { return omega; }
+    return -1.0;
+}
+
+/// Triangle light, uniform in solid angle (spherical triangle), else by area. Measure: solid angle.
+fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+    let v0 = tri_verts[3u * prim].xyz;
+    let v1 = tri_verts[3u * prim + 1u].xyz;
+    let v2 = tri_verts[3u * prim + 2u].xyz;
+    let omega = triangle_light_omega(v0, v1, v2, p);
+    if (omega == 0.0) { return no_light_sample(); }
+    if (omega < 0.0) { return triangle_sample_li(prim, p, u); }
+    let wi = square_to_spherical_triangle(u, v0 - p, v1 - p, v2 - p);
+    // The light point: wi meets the triangle's plane at t = (v0 − p)·n / (wi·n).
+    let n = cross(v1 - v0, v2 - v0);
+    let t = dot(v0 - p, n) / dot(wi, n);
+    if (!(t > 0.0) || is_nonfinite(t)) { return no_light_sample(); }
+    let y = p + t * wi;
+    let inv_nn = 1.0 / dot(n, n);
+    let b1 = clamp(dot(cross(y - v0, v2 - v0), n) * inv_nn, 0.0, 1.0);
+    let b2 = clamp(dot(cross(v1 - v0, y - v0), n) * inv_nn, 0.0, 1.0);
+    let sh = tri_shading[prim];
+    let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
+    let emitted = material_emission(materials[sh.material], uv);
+    return LightSample(wi, t, emitted, 1.0 / omega, false);
+}
+
+/// A quad light's frame for spherical-rectangle sampling: unit edges x, y, front normal z, edge lengths, and
+/// the spherical rectangle seen from p (`rect.omega` ≤ 0: see `quad_light_frame`).
+struct QuadLightFrame {
+    x: vec3<f32>,
+    y: vec3<f32>,
+    z: vec3<f32>,
+    lu: f32,
+    lv: f32,
+    rect: SphericalRect,
+}
+
+/// Like `triangle_light_omega` for quads: `rect.omega` > 0 when spherical-rectangle sampling applies, −1 when p
+/// is in front but area sampling is used (not a rectangle, or Ω out of range), 0 when p sees its back.
+fn quad_light_frame(q: Quad, p: vec3<f32>) -> QuadLightFrame {
+    var f: QuadLightFrame;
+    f.rect.omega = 0.0;
+    let c = cross(q.edge_u, q.edge_v);
+    let d = q.corner - p;
+    if (!(dot(-d, c) > 0.0)) { return f; }
+    f.rect.omega = -1.0;
+    f.lu = length(q.edge_u);
+    f.lv = length(q.edge_v);
+    if (!(abs(dot(q.edge_u, q.edge_v)) <= RECT_COS_TOLERANCE * f.lu * f.lv)) { return f; }
+    f.x = q.edge_u / f.lu;
+    f.y = q.edge_v / f.lv;
+    f.z = normalize(c);
+    let r = spherical_rect_setup(dot(d, f.x), dot(d, f.y), f.lu, f.lv, -dot(d, f.z));
+    if (r.omega >= SPHERICAL_RECT_MIN_SR && r.omega <= SPHERICAL_RECT_MAX_SR) { f.rect = r; }
+    return f;
+}
+
+/// Quad light, uniform in solid angle (spherical rectangle) when it is a rectangle, else by area.
+/// Measure: solid angle.
+fn quad_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+    let q = quads[prim];
+    let f = quad_light_frame(q, p);
+    if (f.rect.omega == 0.0) { return no_light_sample(); }
+    if (f.rect.omega < 0.0) { return quad_sample_li(prim, p, u); }
+    let xy = square_to_spherical_rectangle(u, f.rect);
+    let v = xy.x * f.x + xy.y * f.y - f.rect.h * f.z;
+    let dist = length(v);
+    let st = vec2<f32>((xy.x - f.rect.x0) / f.lu, (xy.y - f.rect.y0) / f.lv);
+    let emitted = material_emission(materials[q.material], st);
+    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, false);
 }
 
 // ---- delta lights ----
@@ -152,10 +268,10 @@ fn directional_sample_li(l: Light) -> LightSample {
 // ---- environment ----
 
 /// Direction → equirectangular (u, v) in map space: u = 0.5 looks down −Z, v = 0 is +Y;
-/// the map is rotated by `env_rotation` radians about +Y.
+/// the map is rotated by `env_rotation` radians about +Y. θ from atan2 (acos(w.y) loses digits at the poles).
 fn env_direction_to_uv(w: vec3<f32>) -> vec2<f32> {
     let u = atan2(w.x, -w.z) * INV_TWO_PI + 0.5 - params.env_rotation * INV_TWO_PI;
-    return vec2<f32>(fract(u), acos(clamp(w.y, -1.0, 1.0)) * INV_PI);
+    return vec2<f32>(fract(u), atan2(length(w.xz), w.y) * INV_PI);
 }
 
 fn env_uv_to_direction(uv: vec2<f32>) -> vec3<f32> {
@@ -178,28 +294,30 @@ fn env_eval(w: vec3<f32>) -> vec3<f32> {
     return env_texels[env_texel_index(env_direction_to_uv(w))].xyz * params.env_scale;
 }
 
-/// pdf (solid angle) of `env_sample_li` producing w.
+/// pdf (solid angle) of `env_sample_li` producing w: 1/4π (uniform), or density_uv / (2π² sinθ) (importance).
+/// sinθ = |w.xz| (1 − w.y² loses its digits near the poles).
 fn env_pdf(w: vec3<f32>) -> f32 {
     if (ENV_KIND == 0u) { return 0.0; }
     if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
     let density_uv = env_texels[env_texel_index(uv)].w;
-    let sin_theta = safe_sqrt(1.0 - w.y * w.y);
+    let sin_theta = length(w.xz);
     return density_uv / (2.0 * PI * PI * max(sin_theta, 1e-7));
 }
 
-/// Environment: uniform on the sphere, or texel ∝ luminance·sinθ by the alias table then uniform in (u, v)
-/// inside the texel (so pdf_ω = density_uv / (2π² sinθ)).
+/// Environment: uniform on the sphere, or a texel ∝ luminance·sinθ by the alias table (column from u.z, coin
+/// from u.y, which is then reused) and uniform in (u, v) inside the texel, so pdf_ω = density_uv / (2π² sinθ).
+/// Measure: solid angle.
 fn env_sample_li(u: vec3<f32>) -> LightSample {
     var wi: vec3<f32>;
     if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) {
         wi = square_to_uniform_sphere(u.xy);
     } else {
         let n = params.env_width * params.env_height;
-        let t = alias_sample(0u, n, u.z, true);
-        let x = t % params.env_width;
-        let y = t / params.env_width;
-        let uv = vec2<f32>((f32(x) + u.x) / f32(params.env_width), (f32(y) + u.y) / f32(params.env_height));
+        let pick = alias_sample2(0u, n, u.z, u.y, true);
+        let x = pick.index % params.env_width;
+        let y = pick.index / params.env_width;
+        let uv = vec2<f32>((f32(x) + u.x) / f32(params.env_width), (f32(y) + pick.u) / f32(params.env_height));
         wi = env_uv_to_direction(uv);
     }
     let pdf = env_pdf(wi);
@@ -212,12 +330,21 @@ fn env_sample_li(u: vec3<f32>) -> LightSample {
 /// Samples a point or direction on light `i` as seen from p (without the selection probability).
 fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let l = lights[i];
+    let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
     switch (l.kind) {
-        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_sample_li(l.prim, p, u.xy); } }
-        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_sample_li(l.prim, p, u.xy); } }
+        case LIGHT_TRIANGLE: {
+            if (!HAS_TRIANGLE_LIGHTS) { return no_light_sample(); }
+            if (solid_angle) { return triangle_sample_li_solid_angle(l.prim, p, u.xy); }
+            return triangle_sample_li(l.prim, p, u.xy);
+        }
+        case LIGHT_QUAD: {
+            if (!HAS_QUAD_LIGHTS) { return no_light_sample(); }
+            if (solid_angle) { return quad_sample_li_solid_angle(l.prim, p, u.xy); }
+            return quad_sample_li(l.prim, p, u.xy);
+        }
         case LIGHT_SPHERE: {
             if (!HAS_SPHERE_LIGHTS) { return no_light_sample(); }
-            if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE) { return sphere_sample_li_cone(l.prim, p, u.xy); }
+            if (solid_angle) { return sphere_sample_li_cone(l.prim, p, u.xy); }
             return sphere_sample_li_area(l.prim, p, u.xy);
         }
         case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_sample_li(l, p); } }
@@ -230,18 +357,51 @@ fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
 }
 
 /// pdf (solid angle, without selection) that `light_sample_li` for light i produces the point y
-/// (normal n_y, outward/front) seen from p along wi. For the environment y is unused.
+/// (normal n_y, either orientation) seen from p along wi. For the environment y is unused. The fallback
+/// decisions are the samplers' own (`triangle_light_omega`, `quad_light_frame`, `sphere_cone_one_minus_cos`);
+/// a triangle or quad seen from behind has pdf 0 (one-sided emitters).
 fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
     let l = lights[i];
     if (l.kind == LIGHT_ENVIRONMENT) { return env_pdf(wi); }
-    if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE && cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE) {
-        let omc = sphere_cone_one_minus_cos(spheres[l.prim], p);
-        if (omc > 0.0) { return square_to_uniform_cone_pdf(omc); }
-    }
     if (l.kind > LIGHT_QUAD) { return 0.0; }
+    let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
     let v = y - p;
     let d2 = dot(v, v);
-    let cos_l = abs(dot(wi, n_y));
-    if (!(cos_l > 0.0)) { return 0.0; }
-    return d2 / (l.area * cos_l);
+    if (HAS_TRIANGLE_LIGHTS && l.kind == LIGHT_TRIANGLE) {
+        let v0 = tri_verts[3u * l.prim].xyz;
+        let v1 = tri_verts[3u * l.prim + 1u].xyz;
+        let v2 = tri_verts[3u * l.prim + 2u].xyz;
+        let n = cross(v1 - v0, v2 - v0);
+        if (solid_angle) {
+            let omega = triangle_light_omega(v0, v1, v2, p);
+            if (omega == 0.0) { return 0.0; }
+            if (omega > 0.0) { return 1.0 / omega; }
+        } else if (!(dot(p - v0, n) > 0.0)) { return 0.0; }
+        // Area: (2/|n|)·d² / cos_l with cos_l = |wi·n|/|n|.
+        let c = abs(dot(wi, n));
+        if (!(c > 0.0)) { return 0.0; }
+        return 2.0 * d2 / c;
+    }
+    if (HAS_QUAD_LIGHTS && l.kind == LIGHT_QUAD) {
+        let q = quads[l.prim];
+        let n = cross(q.edge_u, q.edge_v);
+        if (solid_angle) {
+            let f = quad_light_frame(q, p);
+            if (f.rect.omega == 0.0) { return 0.0; }
+            if (f.rect.omega > 0.0) { return 1.0 / f.rect.omega; }
+        } else if (!(dot(p - q.corner, n) > 0.0)) { return 0.0; }
+        let c = abs(dot(wi, n));
+        if (!(c > 0.0)) { return 0.0; }
+        return d2 / c;
+    }
+    if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE) {
+        if (solid_angle) {
+            let omc = sphere_cone_one_minus_cos(spheres[l.prim], p);
+            if (omc > 0.0) { return square_to_uniform_cone_pdf(omc); }
+        }
+        let cos_l = abs(dot(wi, n_y));
+        if (!(cos_l > 0.0)) { return 0.0; }
+        return d2 / (l.area * cos_l);
+    }
+    return 0.0;
 }

@@ -85,3 +85,148 @@ fn square_to_uniform_triangle(u: vec2<f32>) -> vec2<f32> {
     }
     return vec2<f32>(b1, 1.0 - b0 - b1);
 }
+
+// ---- spherical polygons (solid-angle sampling of triangle and rectangle lights) ----
+//
+// Both warps take the polygon's vertices RELATIVE TO THE SHADING POINT (unnormalised) and are written so that
+// small and distant polygons keep their precision in f32: every quantity that shrinks with the polygon's
+// angular size s is computed from edge vectors or by half-angle identities rather than as a difference of O(1)
+// numbers, so relative errors grow like ε/s (ε = 2⁻²⁴) instead of ε/s². No compensated arithmetic (lavapipe
+// reassociates it away). Where f32 still breaks down — measured in tests/sampling.rs, documented in
+// docs/sampling.md — lights.wgsl falls back to area sampling.
+
+/// Solid angle of the triangle with vertices a, b, c (relative to the viewpoint), Van Oosterom & Strackee 1983:
+/// tan(Ω/2) = |â·(b̂×ĉ)| / (1 + â·b̂ + b̂·ĉ + ĉ·â). The triple product is a·((b − a)×(c − a)) / (|a||b||c|),
+/// from the edges, so it keeps full relative precision for small triangles. Range [0, 2π).
+fn spherical_triangle_solid_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    let la = length(a);
+    let lb = length(b);
+    let lc = length(c);
+    let det = dot(a, cross(b - a, c - a)) / (la * lb * lc);
+    let den = 1.0 + dot(a, b) / (la * lb) + dot(b, c) / (lb * lc) + dot(c, a) / (lc * la);
+    return 2.0 * atan2(abs(det), den);
+}
+
+/// Uniform over the spherical triangle (a, b, c) seen from the origin (vertices relative to the viewpoint).
+/// Measure: solid angle, pdf 1/Ω (`square_to_spherical_triangle_pdf`). Arvo 1995, "Stratified Sampling of
+/// Spherical Triangles": u.x picks the sub-triangle (â, b̂, ĉ′) of area u.x·Ω with ĉ′ on the arc â→ĉ, u.y a
+/// point on the arc b̂→ĉ′ uniform in cosθ. Step 1 is solved in closed form with the Van Oosterom–Strackee
+/// formula instead of Arvo's spherical trigonometry: for ĉ′ = cosφ·â + sinφ·ŵ (ŵ ⊥ â in the plane of â, ĉ),
+///   tan(Ω′/2)·[(1 + â·b̂)(1 + cosφ) + sinφ (b̂·ŵ)] = sinφ |[â, b̂, ŵ]|
+/// ⇒ φ/2 = atan2((1 + â·b̂)·sin(Ω′/2), |[â, b̂, ŵ]|·cos(Ω′/2) − (b̂·ŵ)·sin(Ω′/2)),
+/// which has no cancellation for small triangles (Arvo's and pbrt-v4's forms lose digits there).
+fn square_to_spherical_triangle(u: vec2<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+    let la = length(a);
+    let lb = length(b);
+    let e1 = b - a;
+    let e2 = c - a;
+    let an = a / la;
+    let bn = b / lb;
+    let omega = spherical_triangle_solid_angle(a, b, c);
+    // ŵ ⊥ â towards ĉ: (a × c) × a with a × c = a × e2 (exact for nearby vertices).
+    let w = normalize(cross(cross(a, e2), a));
+    let d = abs(dot(cross(a, e1), w)) / (la * lb);     // |[â, b̂, ŵ]|
+    let e = dot(e1, w) / lb;                          // b̂·ŵ (a·ŵ = 0)
+    let k = 1.0 + dot(an, bn);
+    let half = 0.5 * u.x * omega;
+    let sh = sin(half);
+    let half_phi = atan2(k * sh, d * cos(half) - e * sh);
+    let s_half = sin(half_phi);
+    // ĉ′ − b̂ = (â − b̂) + (cosφ − 1)·â + sinφ·ŵ, with cosφ − 1 = −2 sin²(φ/2).
+    let delta = (an - bn) - (2.0 * s_half * s_half) * an + sin(2.0 * half_phi) * w;
+    // Step 2: cosθ uniform in [b̂·ĉ′, 1] along the arc from b̂; 1 − b̂·ĉ′ = |ĉ′ − b̂|²/2.
+    let omc = u.y * 0.5 * dot(delta, delta);
+    let sin_theta = safe_sqrt(omc * (2.0 - omc));
+    let perp = normalize(delta - dot(delta, bn) * bn);
+    return normalize((1.0 - omc) * bn + sin_theta * perp);
+}
+fn square_to_spherical_triangle_pdf(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    return 1.0 / spherical_triangle_solid_angle(a, b, c);
+}
+
+/// A rectangle prepared for solid-angle sampling, in its local frame: the viewpoint at the origin, the rectangle
+/// [x0, x1] × [y0, y1] in the plane z = −h (h > 0). `beta_sum` = β0 + β1 and `beta_diff` = β1 − β0, with
+/// βi = atan2(yi, h) the elevation of edge y = yi; `psi0`, `psi1` = ψ(x0), ψ(x1) (see below); `omega` = Ω.
+struct SphericalRect {
+    x0: f32,
+    x1: f32,
+    y0: f32,
+    y1: f32,
+    h: f32,
+    beta_sum: f32,
+    beta_diff: f32,
+    psi0: f32,
+    psi1: f32,
+    omega: f32,
+}
+
+/// ψ(X): the signed solid angle of the strip [0, X] × [y0, y1] at depth h,
+/// atan(X·y1/(h·R1)) − atan(X·y0/(h·R0)) with Ri = |(X, yi, h)|, as one atan2 whose y1·R0 − y0·R1 is rationalised
+/// when y0, y1 have the same sign (it cancels for small rectangles otherwise).
+fn spherical_rect_psi(x: f32, y0: f32, y1: f32, h: f32) -> f32 {
+    let r0 = sqrt(x * x + y0 * y0 + h * h);
+    let r1 = sqrt(x * x + y1 * y1 + h * h);
+    var m = y1 * r0 - y0 * r1;
+    if (y0 * y1 > 0.0) { m = (x * x + h * h) * (y1 - y0) * (y1 + y0) / (y1 * r0 + y0 * r1); }
+    return atan2(x * h * m, h * h * r0 * r1 + x * x * y0 * y1);
+}
+
+/// Local coordinates of a rectangle light seen from the origin; `h` must be > 0 (the caller checks the side).
+fn spherical_rect_setup(x0: f32, y0: f32, w: f32, hgt: f32, h: f32) -> SphericalRect {
+    var r: SphericalRect;
+    r.x0 = x0;
+    r.x1 = x0 + w;
+    r.y0 = y0;
+    r.y1 = y0 + hgt;
+    r.h = h;
+    r.beta_sum = atan2(r.y0, h) + atan2(r.y1, h);
+    // β1 − β0: the angle between (y0, h) and (y1, h), from the edge length (no cancellation).
+    r.beta_diff = atan2(h * hgt, h * h + r.y0 * r.y1);
+    r.psi0 = spherical_rect_psi(r.x0, r.y0, r.y1, h);
+    r.psi1 = spherical_rect_psi(r.x1, r.y0, r.y1, h);
+    // Ω: two Van Oosterom–Strackee triangles; both triple products equal h·w·hgt exactly.
+    let v00 = vec3<f32>(r.x0, r.y0, -h);
+    let v10 = vec3<f32>(r.x1, r.y0, -h);
+    let v11 = vec3<f32>(r.x1, r.y1, -h);
+    let v01 = vec3<f32>(r.x0, r.y1, -h);
+    let l00 = length(v00);
+    let l10 = length(v10);
+    let l11 = length(v11);
+    let l01 = length(v01);
+    let vol = h * w * hgt;
+    let c0011 = dot(v00, v11) / (l00 * l11);
+    let t1 = atan2(vol / (l00 * l10 * l11), 1.0 + dot(v00, v10) / (l00 * l10) + dot(v10, v11) / (l10 * l11) + c0011);
+    let t2 = atan2(vol / (l00 * l11 * l01), 1.0 + c0011 + dot(v11, v01) / (l11 * l01) + dot(v01, v00) / (l01 * l00));
+    r.omega = 2.0 * (t1 + t2);
+    return r;
+}
+
+/// Uniform over the spherical rectangle `r` (from `spherical_rect_setup`), returned as the local point
+/// (x, y) on the rectangle (the direction is normalize((x, y, −h))). Measure: solid angle, pdf 1/Ω.
+/// Ureña, Fajardo & King 2013, "An Area-Preserving Parametrization for Spherical Rectangles": u.x picks the
+/// sub-rectangle [x0, x] of solid angle u.x·Ω, u.y a point on the segment at x uniform in y/|(x, y, h)|.
+/// Reformulated for f32: the paper's angle sum minus π at the edge x is ψ(x) (`spherical_rect_psi`), so
+/// ψ = lerp(ψ(x0), ψ(x1), u.x) and, solving the paper's eqs. for x with half-angle identities,
+///   x = h·sinψ / (2·sqrt(cos((Σ+ψ)/2)·cos((Σ−ψ)/2)·sin((Δ−ψ)/2)·sin((Δ+ψ)/2))),  Σ = β0 + β1, Δ = β1 − β0,
+/// a product without cancellation; in step 2, 1 ∓ hv are interpolated from 1 ∓ hi computed without cancellation,
+/// so grazing rectangles (hv → ±1) keep their precision.
+fn square_to_spherical_rectangle(u: vec2<f32>, r: SphericalRect) -> vec2<f32> {
+    let psi = mix(r.psi0, r.psi1, u.x);
+    let q = cos(0.5 * (r.beta_sum + psi)) * cos(0.5 * (r.beta_sum - psi)) * sin(0.5 * (r.beta_diff - psi)) * sin(0.5 * (r.beta_diff + psi));
+    let x = clamp(r.h * sin(psi) / (2.0 * sqrt(max(q, 0.0))), r.x0, r.x1);
+    let dd2 = x * x + r.h * r.h;
+    let r0 = sqrt(dd2 + r.y0 * r.y0);
+    let r1 = sqrt(dd2 + r.y1 * r.y1);
+    let h0 = r.y0 / r0;
+    let h1 = r.y1 / r1;
+    // 1 − hi and 1 + hi without cancellation: 1 − y/r = dd²/(r (r + y)) for y > 0, and symmetrically.
+    let om0 = select(1.0 - h0, dd2 / (r0 * (r0 + r.y0)), r.y0 > 0.0);
+    let om1 = select(1.0 - h1, dd2 / (r1 * (r1 + r.y1)), r.y1 > 0.0);
+    let op0 = select(1.0 + h0, dd2 / (r0 * (r0 - r.y0)), r.y0 < 0.0);
+    let op1 = select(1.0 + h1, dd2 / (r1 * (r1 - r.y1)), r.y1 < 0.0);
+    let hv = mix(h0, h1, u.y);
+    let one_minus_hv2 = mix(om0, om1, u.y) * mix(op0, op1, u.y);
+    let y = clamp(hv * sqrt(dd2) / sqrt(one_minus_hv2), r.y0, r.y1);
+    return vec2<f32>(x, y);
+}
+fn square_to_spherical_rectangle_pdf(r: SphericalRect) -> f32 { return 1.0 / r.omega; }

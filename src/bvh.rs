@@ -18,7 +18,9 @@ use std::time::Instant;
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3, Vec3A};
 
-use crate::gpu_types::{make_prim, GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE, PRIM_TRIANGLE};
+use crate::gpu_types::{
+    make_prim, GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE, PRIM_TRIANGLE,
+};
 
 /// A BVH2 node with both children's boxes (WGSL `BvhNode`, same field names). See the module docs for the
 /// meaning of `*_first` / `*_count`.
@@ -141,7 +143,10 @@ fn next_down(x: f32) -> f32 {
 }
 
 fn outward(min: Vec3, max: Vec3) -> Aabb {
-    Aabb { min: Vec3::new(next_down(min.x), next_down(min.y), next_down(min.z)), max: Vec3::new(next_up(max.x), next_up(max.y), next_up(max.z)) }
+    Aabb {
+        min: Vec3::new(next_down(min.x), next_down(min.y), next_down(min.z)),
+        max: Vec3::new(next_up(max.x), next_up(max.y), next_up(max.z)),
+    }
 }
 
 /// The box of a triangle, or `None` if it is excluded from the BVH (non-finite, or exactly zero area: the edge
@@ -254,7 +259,8 @@ fn build_obvhs(boxes: &[Aabb]) -> (Vec<TmpNode>, Vec<u32>) {
     let extent = (hi - lo).max_element();
     let scale = if extent > 0.0 && extent.is_finite() { 2.0 / extent } else { 1.0 };
     let norm = |p: Vec3| Vec3A::from(((p.as_dvec3() - center) * scale).as_vec3());
-    let aabbs: Vec<obvhs::aabb::Aabb> = boxes.iter().map(|b| obvhs::aabb::Aabb::new(norm(b.min), norm(b.max))).collect();
+    let aabbs: Vec<obvhs::aabb::Aabb> =
+        boxes.iter().map(|b| obvhs::aabb::Aabb::new(norm(b.min), norm(b.max))).collect();
     let mut core_time = std::time::Duration::ZERO;
     let bvh2 = obvhs::bvh2::builder::build_bvh2(&aabbs, build_params(), &mut core_time);
 
@@ -298,7 +304,13 @@ fn build_median(boxes: &[Aabb]) -> (Vec<TmpNode>, Vec<u32>) {
             hi = hi.max(centroid(i));
         }
         let e = hi - lo;
-        let axis = if e.x >= e.y && e.x >= e.z { 0 } else if e.y >= e.z { 1 } else { 2 };
+        let axis = if e.x >= e.y && e.x >= e.z {
+            0
+        } else if e.y >= e.z {
+            1
+        } else {
+            2
+        };
         let mid = a + n / 2;
         order[a..b].select_nth_unstable_by(n / 2, |&i, &j| centroid(i)[axis].total_cmp(&centroid(j)[axis]));
         let (l, r) = (tmp.len(), tmp.len() + 1);
@@ -338,8 +350,16 @@ fn empty_child() -> ([f32; 3], [f32; 3]) {
 /// SAH cost on the way.
 fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh {
     let (emin, emax) = empty_child();
-    let empty_node =
-        GpuBvhNode { lmin: emin, l_first: EMPTY_CHILD, lmax: emax, l_count: 0, rmin: emin, r_first: EMPTY_CHILD, rmax: emax, r_count: 0 };
+    let empty_node = GpuBvhNode {
+        lmin: emin,
+        l_first: EMPTY_CHILD,
+        lmax: emax,
+        l_count: 0,
+        rmin: emin,
+        r_first: EMPTY_CHILD,
+        rmax: emax,
+        r_count: 0,
+    };
     if tmp.is_empty() {
         return Bvh { nodes: vec![empty_node], prim_refs: Vec::new(), build_seconds: 0.0, sah_cost: 0.0 };
     }
@@ -349,7 +369,9 @@ fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh 
     for i in (0..tmp.len()).rev() {
         let t = tmp[i];
         tbox[i] = if t.count > 0 {
-            order[t.first as usize..(t.first + t.count) as usize].iter().fold(Aabb::EMPTY, |a, &p| a.union(&boxes[p as usize]))
+            order[t.first as usize..(t.first + t.count) as usize]
+                .iter()
+                .fold(Aabb::EMPTY, |a, &p| a.union(&boxes[p as usize]))
         } else {
             tbox[t.left as usize].union(&tbox[t.right as usize])
         };
@@ -376,7 +398,11 @@ fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh 
         let out = nodes.len() as u32;
         if parent != usize::MAX {
             let p = &mut nodes[parent];
-            if is_right { p.r_first = out } else { p.l_first = out }
+            if is_right {
+                p.r_first = out
+            } else {
+                p.l_first = out
+            }
         }
         let t = tmp[ti];
         sah += rel(&tbox[ti]); // traversal cost 1
@@ -387,7 +413,8 @@ fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh 
             let b = tbox[c];
             let (first, count) = if ct.count > 0 {
                 let first = prim_refs.len() as u32;
-                prim_refs.extend(order[ct.first as usize..(ct.first + ct.count) as usize].iter().map(|&p| refs[p as usize]));
+                prim_refs
+                    .extend(order[ct.first as usize..(ct.first + ct.count) as usize].iter().map(|&p| refs[p as usize]));
                 sah += rel(&b) * ct.count as f64; // intersection cost 1 per primitive
                 (first, ct.count)
             } else {
@@ -487,7 +514,8 @@ pub mod reference {
 
     /// Ray–parallelogram in f64; `pad` widens the (s, t) domain to [−pad, 1 + pad]².
     pub fn quad(ray: &Ray, q: &GpuQuad, pad: f64) -> Option<(f64, f64, f64, f64)> {
-        let (p, u, v) = (Vec3::from(q.corner).as_dvec3(), Vec3::from(q.edge_u).as_dvec3(), Vec3::from(q.edge_v).as_dvec3());
+        let (p, u, v) =
+            (Vec3::from(q.corner).as_dvec3(), Vec3::from(q.edge_u).as_dvec3(), Vec3::from(q.edge_v).as_dvec3());
         let n = u.cross(v);
         let denom = n.dot(ray.d);
         if denom == 0.0 {

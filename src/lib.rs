@@ -16,3 +16,4 @@ pub mod render;
 pub mod settings;
 pub mod progressive;
 pub mod features;
+pub mod chi2;

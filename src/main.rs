@@ -247,6 +247,13 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         (None, None) => Budget::Samples(64),
     };
     let t_start = Instant::now();
+    // Catch Ctrl-C from the start: during start-up it stops before rendering, afterwards it writes
+    // what has accumulated.
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let t_device = Instant::now();
@@ -281,10 +288,9 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         (t_loaded - t_device).as_secs_f64(),
         (t_ready - t_loaded).as_secs_f64()
     );
-    let interrupt = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupt.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    if interrupt.load(Ordering::SeqCst) {
+        eprintln!("interrupted during start-up: nothing was rendered and no image was written");
+        return Ok(EXIT_INTERRUPTED);
     }
     let bar = match budget {
         Budget::Samples(n) => indicatif::ProgressBar::new(n as u64),

@@ -97,7 +97,11 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }
@@ -111,18 +115,25 @@ impl<'a> Probe<'a> {
     /// Validates, builds and dispatches one kernel, waits (with the context's timeout) and returns the first
     /// `output_bytes` of the output buffer. wgpu validation errors come back as [`ProbeError::Validation`].
     pub fn run(&self, job: &ProbeJob) -> Result<Vec<u8>, ProbeError> {
-        crate::shaders::validate(job.source).map_err(|e| ProbeError::Shader(format!("probe '{}' failed to validate:\n{e}", job.entry)))?;
+        crate::shaders::validate(job.source)
+            .map_err(|e| ProbeError::Shader(format!("probe '{}' failed to validate:\n{e}", job.entry)))?;
         let device = &self.ctx.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
 
         let geometry_layout = job.geometry.map(|_| {
             let entries: Vec<_> = (0..5).map(|b| storage_entry(b, true)).collect();
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("probe geometry"), entries: &entries })
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("probe geometry"),
+                entries: &entries,
+            })
         });
         let io_entries: Vec<_> = std::iter::once(storage_entry(0, false))
             .chain((0..job.inputs.len() as u32).map(|k| storage_entry(1 + k, true)))
             .collect();
-        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("probe io"), entries: &io_entries });
+        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("probe io"),
+            entries: &io_entries,
+        });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("probe"),
             bind_group_layouts: &[geometry_layout.as_ref(), Some(&io_layout)],
@@ -137,7 +148,10 @@ impl<'a> Probe<'a> {
             layout: Some(&pipeline_layout),
             module: &module,
             entry_point: Some(job.entry),
-            compilation_options: wgpu::PipelineCompilationOptions { constants: job.constants, zero_initialize_workgroup_memory: false },
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: job.constants,
+                zero_initialize_workgroup_memory: false,
+            },
             cache: None,
         });
 
@@ -149,21 +163,44 @@ impl<'a> Probe<'a> {
             contents: bytemuck::cast_slice(&fill),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         });
-        let inputs: Vec<wgpu::Buffer> = job.inputs.iter().map(|bytes| self.ctx.storage_buffer("probe input", bytes, wgpu::BufferUsages::empty())).collect();
+        let inputs: Vec<wgpu::Buffer> = job
+            .inputs
+            .iter()
+            .map(|bytes| self.ctx.storage_buffer("probe input", bytes, wgpu::BufferUsages::empty()))
+            .collect();
 
         let geometry_group = job.geometry.zip(geometry_layout.as_ref()).map(|(g, layout)| {
-            let entries: Vec<_> =
-                g.buffers().iter().enumerate().map(|(b, buf)| wgpu::BindGroupEntry { binding: b as u32, resource: buf.as_entire_binding() }).collect();
-            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("probe geometry"), layout, entries: &entries })
+            let entries: Vec<_> = g
+                .buffers()
+                .iter()
+                .enumerate()
+                .map(|(b, buf)| wgpu::BindGroupEntry { binding: b as u32, resource: buf.as_entire_binding() })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("probe geometry"),
+                layout,
+                entries: &entries,
+            })
         });
-        let io_bind: Vec<_> = std::iter::once(wgpu::BindGroupEntry { binding: 0, resource: output.as_entire_binding() })
-            .chain(inputs.iter().enumerate().map(|(k, b)| wgpu::BindGroupEntry { binding: 1 + k as u32, resource: b.as_entire_binding() }))
-            .collect();
-        let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("probe io"), layout: &io_layout, entries: &io_bind });
+        let io_bind: Vec<_> =
+            std::iter::once(wgpu::BindGroupEntry { binding: 0, resource: output.as_entire_binding() })
+                .chain(
+                    inputs
+                        .iter()
+                        .enumerate()
+                        .map(|(k, b)| wgpu::BindGroupEntry { binding: 1 + k as u32, resource: b.as_entire_binding() }),
+                )
+                .collect();
+        let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("probe io"),
+            layout: &io_layout,
+            entries: &io_bind,
+        });
 
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("probe") });
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probe"), timestamp_writes: None });
+            let mut pass = encoder
+                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probe"), timestamp_writes: None });
             pass.set_pipeline(&pipeline);
             if let Some(g) = &geometry_group {
                 pass.set_bind_group(0, g, &[]);

@@ -133,7 +133,8 @@ fn bounding_sphere(g: &Geometry, prim: u32) -> (DVec3, f64) {
         PRIM_SPHERE => (Vec3::from(g.spheres[i].center).as_dvec3(), g.spheres[i].radius as f64),
         _ => {
             let q = &g.quads[i];
-            let (p, u, v) = (Vec3::from(q.corner).as_dvec3(), Vec3::from(q.edge_u).as_dvec3(), Vec3::from(q.edge_v).as_dvec3());
+            let (p, u, v) =
+                (Vec3::from(q.corner).as_dvec3(), Vec3::from(q.edge_u).as_dvec3(), Vec3::from(q.edge_v).as_dvec3());
             (p + 0.5 * (u + v), 0.5 * (u + v).length().max((u - v).length()))
         }
     }
@@ -151,7 +152,9 @@ impl Culled {
         let mut chunks = Vec::new();
         for start in (0..prims.len()).step_by(32) {
             let end = (start + 32).min(prims.len());
-            let (lo, hi) = prims[start..end].iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), (_, c, r)| (lo.min(*c - *r), hi.max(*c + *r)));
+            let (lo, hi) = prims[start..end]
+                .iter()
+                .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), (_, c, r)| (lo.min(*c - *r), hi.max(*c + *r)));
             let center = (lo + hi) * 0.5;
             let radius = prims[start..end].iter().map(|(_, c, r)| (*c - center).length() + r).fold(0.0, f64::max);
             chunks.push((center, radius * (1.0 + 1e-9), start, end));
@@ -197,7 +200,10 @@ fn reference_hits(g: &Geometry, rays: &[ProbeRay]) -> Vec<Option<RefHit>> {
     let scene = g.scene();
     let half = rays.len().div_ceil(2).max(1);
     std::thread::scope(|s| {
-        let parts: Vec<_> = rays.chunks(half).map(|part| s.spawn(|| part.iter().map(|r| culled.closest(&scene, &ray64(r))).collect::<Vec<_>>())).collect();
+        let parts: Vec<_> = rays
+            .chunks(half)
+            .map(|part| s.spawn(|| part.iter().map(|r| culled.closest(&scene, &ray64(r))).collect::<Vec<_>>()))
+            .collect();
         parts.into_iter().flat_map(|h| h.join().unwrap()).collect()
     })
 }
@@ -356,7 +362,12 @@ fn check(name: &str, s: &Stats, max_odd: f64) {
     // Grazing hits whose t needed more than T_REL (within the 1/cos θ error bound) must be rare too.
     assert!((s.grazing as f64) < 1e-2 * s.rays as f64, "{name}: {} grazing hits of {} rays (≥ 1 %)", s.grazing, s.rays);
     let odd = s.ties + s.near_edge;
-    assert!((odd as f64) < max_odd * s.rays as f64, "{name}: {odd} tie/edge cases of {} rays (≥ {} %)", s.rays, 100.0 * max_odd);
+    assert!(
+        (odd as f64) < max_odd * s.rays as f64,
+        "{name}: {odd} tie/edge cases of {} rays (≥ {} %)",
+        s.rays,
+        100.0 * max_odd
+    );
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -388,7 +399,9 @@ fn point_on(g: &Geometry, prim: u32, rng: &mut Pcg64) -> DVec3 {
         PRIM_SPHERE => Vec3::from(g.spheres[i].center).as_dvec3() + unit(rng) * g.spheres[i].radius as f64 * 0.999,
         _ => {
             let q = &g.quads[i];
-            Vec3::from(q.corner).as_dvec3() + rng.random::<f64>() * Vec3::from(q.edge_u).as_dvec3() + rng.random::<f64>() * Vec3::from(q.edge_v).as_dvec3()
+            Vec3::from(q.corner).as_dvec3()
+                + rng.random::<f64>() * Vec3::from(q.edge_u).as_dvec3()
+                + rng.random::<f64>() * Vec3::from(q.edge_v).as_dvec3()
         }
     }
 }
@@ -396,7 +409,7 @@ fn point_on(g: &Geometry, prim: u32, rng: &mut Pcg64) -> DVec3 {
 /// Rays from a sphere around the scene: 90 % aimed at a random point of a random (included) primitive, 10 % at a
 /// random point of the bounds. Of those, 10 % travel exactly along an axis and 5 % have one zero direction
 /// component (the slab test's 1/0 case), and 10 % start inside the bounds. 30 % get a finite t_max (0.2–1.2 × the
-/// distance to the aim point), the rest F32_MAX.
+/// distance to the aim point), 10 % an infinite one, the rest F32_MAX.
 fn make_rays(g: &Geometry, n: usize, seed: u64) -> Vec<ProbeRay> {
     let mut rng = Pcg64::seed_from_u64(seed);
     let included: Vec<u32> = reference::all_prims(&g.scene()).filter(|&p| is_included(g, p)).collect();
@@ -431,10 +444,10 @@ fn make_rays(g: &Geometry, n: usize, seed: u64) -> Vec<ProbeRay> {
                 let o = center + unit(&mut rng) * dist;
                 (o, (target - o).normalize())
             };
-            let t_max = if rng.random::<f64>() < 0.3 {
-                ((target - o).length() * rng.random_range(0.2..1.2)) as f32
-            } else {
-                f32::MAX
+            let t_max = match rng.random::<f64>() {
+                u if u < 0.3 => ((target - o).length() * rng.random_range(0.2..1.2)) as f32,
+                u if u < 0.4 => f32::INFINITY,
+                _ => f32::MAX,
             };
             ProbeRay { o: o.as_vec3().into(), t_max, d: d.as_vec3().into(), _pad: 0.0 }
         })
@@ -462,7 +475,13 @@ fn soup(seed: u64) -> Geometry {
     }
     // A 24×24 grid of quads split into triangles, tilted.
     let n = 24;
-    let vert = |i: usize, j: usize| Vec3::new(-0.8 + 1.6 * i as f32 / n as f32, 0.3 * (i as f32 * 0.7).sin() * (j as f32 * 0.5).cos(), -0.8 + 1.6 * j as f32 / n as f32);
+    let vert = |i: usize, j: usize| {
+        Vec3::new(
+            -0.8 + 1.6 * i as f32 / n as f32,
+            0.3 * (i as f32 * 0.7).sin() * (j as f32 * 0.5).cos(),
+            -0.8 + 1.6 * j as f32 / n as f32,
+        )
+    };
     for i in 0..n {
         for j in 0..n {
             let (a, b, c, d) = (vert(i, j), vert(i + 1, j), vert(i + 1, j + 1), vert(i, j + 1));
@@ -487,7 +506,11 @@ fn soup(seed: u64) -> Geometry {
     tris.push([p, Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE]);
     tris.push([p, Vec3::new(f32::INFINITY, 0.0, 0.0), Vec3::ONE]);
     let mut spheres: Vec<GpuSphere> = (0..100)
-        .map(|_| GpuSphere { center: v3(&mut rng, -1.0, 1.0).into(), radius: rng.random_range(0.01..0.15), ..Default::default() })
+        .map(|_| GpuSphere {
+            center: v3(&mut rng, -1.0, 1.0).into(),
+            radius: rng.random_range(0.01..0.15),
+            ..Default::default()
+        })
         .collect();
     spheres.push(GpuSphere { center: [0.0; 3], radius: 0.0, ..Default::default() });
     spheres.push(GpuSphere { center: [f32::NAN, 0.0, 0.0], radius: 0.1, ..Default::default() });
@@ -519,7 +542,10 @@ fn helmet() -> Geometry {
             assert_eq!(prim.mode(), gltf::mesh::Mode::Triangles);
             let reader = prim.reader(|b| Some(&buffers[b.index()]));
             let pos: Vec<Vec3> = reader.read_positions().expect("positions").map(Vec3::from).collect();
-            let idx: Vec<u32> = reader.read_indices().map(|i| i.into_u32().collect()).unwrap_or_else(|| (0..pos.len() as u32).collect());
+            let idx: Vec<u32> = reader
+                .read_indices()
+                .map(|i| i.into_u32().collect())
+                .unwrap_or_else(|| (0..pos.len() as u32).collect());
             tris.extend(idx.chunks_exact(3).map(|t| [pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]));
         }
     }
@@ -540,7 +566,9 @@ fn check_structure(g: &Geometry, b: &Bvh) {
     while let Some(n) = stack.pop() {
         assert!(!std::mem::replace(&mut visited[n], true), "node {n} reached twice");
         let node = b.nodes[n];
-        for (lo, hi, first, count) in [(node.lmin, node.lmax, node.l_first, node.l_count), (node.rmin, node.rmax, node.r_first, node.r_count)] {
+        for (lo, hi, first, count) in
+            [(node.lmin, node.lmax, node.l_first, node.l_count), (node.rmin, node.rmax, node.r_first, node.r_count)]
+        {
             let bx = bvh::Aabb { min: lo.into(), max: hi.into() };
             if count > 0 {
                 assert!(count <= bvh::MAX_LEAF_PRIMS || b.prim_refs.len() <= bvh::MAX_LEAF_PRIMS as usize);
@@ -558,7 +586,10 @@ fn check_structure(g: &Geometry, b: &Bvh) {
                 }
             } else if first != EMPTY_CHILD {
                 let c = b.nodes[first as usize];
-                let cb = bvh::Aabb { min: Vec3::from(c.lmin).min(c.rmin.into()), max: Vec3::from(c.lmax).max(c.rmax.into()) };
+                let cb = bvh::Aabb {
+                    min: Vec3::from(c.lmin).min(c.rmin.into()),
+                    max: Vec3::from(c.lmax).max(c.rmax.into()),
+                };
                 assert!(bx.contains(&cb), "node {n}'s box of child {first} does not hold its children");
                 stack.push(first as usize);
             }
@@ -580,7 +611,13 @@ fn build_invariants() {
     let b = g.build();
     check_structure(&g, &b);
     assert_eq!(b.prim_refs.len(), 3000 + 24 * 24 * 2 + 30 + 100 + 130, "junk must be excluded");
-    eprintln!("soup: {} nodes, depth {}, SAH {:.1}, {:.1} bytes/triangle", b.node_count(), b.depth(), b.sah_cost, b.bytes_per_triangle());
+    eprintln!(
+        "soup: {} nodes, depth {}, SAH {:.1}, {:.1} bytes/triangle",
+        b.node_count(),
+        b.depth(),
+        b.sah_cost,
+        b.bytes_per_triangle()
+    );
 }
 
 #[test]
@@ -590,26 +627,41 @@ fn build_edge_cases() {
     let b = empty.build();
     assert_eq!(b.nodes.len(), 1);
     assert!(b.prim_refs.is_empty());
-    assert_eq!((b.nodes[0].l_first, b.nodes[0].l_count, b.nodes[0].r_first, b.nodes[0].r_count), (EMPTY_CHILD, 0, EMPTY_CHILD, 0));
+    assert_eq!(
+        (b.nodes[0].l_first, b.nodes[0].l_count, b.nodes[0].r_first, b.nodes[0].r_count),
+        (EMPTY_CHILD, 0, EMPTY_CHILD, 0)
+    );
     assert_eq!(b.sah_cost, 0.0);
     assert_eq!(b.bytes_per_triangle(), 0.0);
 
     let p = Vec3::ONE;
-    let junk = Geometry { tris: vec![[p, p, p]], spheres: vec![GpuSphere { radius: -1.0, ..Default::default() }], quads: vec![] };
+    let junk = Geometry {
+        tris: vec![[p, p, p]],
+        spheres: vec![GpuSphere { radius: -1.0, ..Default::default() }],
+        quads: vec![],
+    };
     assert_eq!(junk.build().prim_refs.len(), 0);
 
     let one = Geometry { tris: vec![[Vec3::ZERO, Vec3::X, Vec3::Y]], spheres: vec![], quads: vec![] };
     let b = one.build();
     check_structure(&one, &b);
     assert_eq!(b.nodes.len(), 1);
-    assert_eq!((b.nodes[0].l_first, b.nodes[0].l_count, b.nodes[0].r_first, b.nodes[0].r_count), (0, 1, EMPTY_CHILD, 0));
+    assert_eq!(
+        (b.nodes[0].l_first, b.nodes[0].l_count, b.nodes[0].r_first, b.nodes[0].r_count),
+        (0, 1, EMPTY_CHILD, 0)
+    );
     assert_eq!(b.prim_refs, vec![make_prim(PRIM_TRIANGLE, 0)]);
     assert_eq!(b.sah_cost, 1.0);
 
     let two = Geometry {
         tris: vec![],
         spheres: vec![GpuSphere { center: [0.0; 3], radius: 1.0, ..Default::default() }],
-        quads: vec![GpuQuad { corner: [3.0, 0.0, 0.0], edge_u: [1.0, 0.0, 0.0], edge_v: [0.0, 1.0, 0.0], ..Default::default() }],
+        quads: vec![GpuQuad {
+            corner: [3.0, 0.0, 0.0],
+            edge_u: [1.0, 0.0, 0.0],
+            edge_v: [0.0, 1.0, 0.0],
+            ..Default::default()
+        }],
     };
     let b = two.build();
     check_structure(&two, &b);
@@ -625,7 +677,8 @@ fn build_pathological_inputs() {
     check_structure(&g, &b);
     // Huge but finite coordinates: no overflow in the builder.
     let mut rng = Pcg64::seed_from_u64(7);
-    let tris: Vec<[Vec3; 3]> = (0..2000).map(|_| [v3(&mut rng, -1e30, 1e30), v3(&mut rng, -1e30, 1e30), v3(&mut rng, -1e30, 1e30)]).collect();
+    let tris: Vec<[Vec3; 3]> =
+        (0..2000).map(|_| [v3(&mut rng, -1e30, 1e30), v3(&mut rng, -1e30, 1e30), v3(&mut rng, -1e30, 1e30)]).collect();
     let g = Geometry { tris, spheres: vec![], quads: vec![] };
     let b = g.build();
     check_structure(&g, &b);
@@ -636,7 +689,8 @@ fn build_pathological_inputs() {
             [Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 0.0), Vec3::new(x, 1.0, 0.0)]
         })
         .collect();
-    let spheres: Vec<GpuSphere> = (0..1000).map(|i| GpuSphere { center: [i as f32, 5.0, 0.0], radius: 0.25, ..Default::default() }).collect();
+    let spheres: Vec<GpuSphere> =
+        (0..1000).map(|i| GpuSphere { center: [i as f32, 5.0, 0.0], radius: 0.25, ..Default::default() }).collect();
     let g = Geometry { tris, spheres, quads: vec![] };
     check_structure(&g, &g.build());
 }
@@ -696,23 +750,45 @@ fn gpu_empty_and_single_primitive_scenes() {
     let p = Vec3::ONE;
     for g in [
         Geometry { tris: vec![], spheres: vec![], quads: vec![] },
-        Geometry { tris: vec![[p, p, p]], spheres: vec![GpuSphere { radius: 0.0, ..Default::default() }], quads: vec![] },
+        Geometry {
+            tris: vec![[p, p, p]],
+            spheres: vec![GpuSphere { radius: 0.0, ..Default::default() }],
+            quads: vec![],
+        },
     ] {
         let b = g.build();
         let rays: Vec<ProbeRay> = (0..4096)
-            .map(|_| ProbeRay { o: v3(&mut rng, -2.0, 2.0).into(), t_max: f32::MAX, d: unit(&mut rng).as_vec3().into(), _pad: 0.0 })
+            .map(|_| ProbeRay {
+                o: v3(&mut rng, -2.0, 2.0).into(),
+                t_max: f32::MAX,
+                d: unit(&mut rng).as_vec3().into(),
+                _pad: 0.0,
+            })
             .collect();
         let out = gpu_trace(&ctx, &g, &b, &rays);
         assert!(out.iter().all(|h| h.prim == INVALID && h.any == 0 && h.t == f32::MAX), "a ray hit an empty scene");
     }
     // One triangle, one sphere, one quad, each alone (the root is a single leaf).
     let singles = [
-        Geometry { tris: vec![[Vec3::new(-1.0, -1.0, 0.2), Vec3::new(1.0, -0.5, 0.0), Vec3::new(0.0, 1.0, -0.3)]], spheres: vec![], quads: vec![] },
-        Geometry { tris: vec![], spheres: vec![GpuSphere { center: [0.2, -0.1, 0.3], radius: 0.7, ..Default::default() }], quads: vec![] },
+        Geometry {
+            tris: vec![[Vec3::new(-1.0, -1.0, 0.2), Vec3::new(1.0, -0.5, 0.0), Vec3::new(0.0, 1.0, -0.3)]],
+            spheres: vec![],
+            quads: vec![],
+        },
+        Geometry {
+            tris: vec![],
+            spheres: vec![GpuSphere { center: [0.2, -0.1, 0.3], radius: 0.7, ..Default::default() }],
+            quads: vec![],
+        },
         Geometry {
             tris: vec![],
             spheres: vec![],
-            quads: vec![GpuQuad { corner: [-0.5, -0.5, 0.1], edge_u: [1.0, 0.2, 0.0], edge_v: [0.1, 0.9, 0.3], ..Default::default() }],
+            quads: vec![GpuQuad {
+                corner: [-0.5, -0.5, 0.1],
+                edge_u: [1.0, 0.2, 0.0],
+                edge_v: [0.1, 0.9, 0.3],
+                ..Default::default()
+            }],
         },
     ];
     for (k, g) in singles.iter().enumerate() {
@@ -720,13 +796,48 @@ fn gpu_empty_and_single_primitive_scenes() {
         assert_eq!(b.nodes.len(), 1);
         let mut rays = make_rays(g, 8192, 10 + k as u64);
         // Rays starting inside the sphere must hit its far side.
-        rays.extend((0..1024).map(|_| ProbeRay { o: [0.2, -0.1, 0.3], t_max: f32::MAX, d: unit(&mut rng).as_vec3().into(), _pad: 0.0 }));
+        rays.extend((0..1024).map(|_| ProbeRay {
+            o: [0.2, -0.1, 0.3],
+            t_max: f32::MAX,
+            d: unit(&mut rng).as_vec3().into(),
+            _pad: 0.0,
+        }));
         let gpu = gpu_trace(&ctx, g, &b, &rays);
         let refs: Vec<_> = rays.iter().map(|r| reference::closest(&g.scene(), &ray64(r))).collect();
         let s = compare(g, &rays, &gpu, &refs, EDGE_MARGIN);
         check(&format!("single primitive {k}"), &s, 1e-3);
         assert!(s.hits > 4000);
     }
+}
+
+#[test]
+fn gpu_degenerate_rays_miss() {
+    // NaN/Inf origins or directions, a zero direction, and t_max ≤ 0 or NaN: no hit, no hang.
+    let ctx = gpu();
+    let g = soup(4);
+    let b = g.build();
+    let (nan, inf) = (f32::NAN, f32::INFINITY);
+    let good_o = [0.0, 0.0, -5.0];
+    let good_d = [0.0, 0.0, 1.0];
+    let cases = [
+        ([nan, 0.0, -5.0], good_d, f32::MAX),
+        ([inf, 0.0, -5.0], good_d, f32::MAX),
+        (good_o, [0.0, nan, 1.0], f32::MAX),
+        (good_o, [0.0, 0.0, inf], f32::MAX),
+        (good_o, [0.0, 0.0, 0.0], f32::MAX),
+        (good_o, good_d, 0.0),
+        (good_o, good_d, -1.0),
+        (good_o, good_d, nan),
+        (good_o, good_d, -inf),
+    ];
+    let rays: Vec<ProbeRay> = cases.iter().map(|&(o, d, t_max)| ProbeRay { o, t_max, d, _pad: 0.0 }).collect();
+    let out = gpu_trace(&ctx, &g, &b, &rays);
+    for (c, h) in cases.iter().zip(&out) {
+        assert!(h.prim == INVALID && h.any == 0, "ray {c:?} should miss: {h:?}");
+    }
+    // The control ray (finite, t_max large) does hit the soup.
+    let control = gpu_trace(&ctx, &g, &b, &[ProbeRay { o: good_o, t_max: f32::MAX, d: good_d, _pad: 0.0 }]);
+    assert!(control[0].prim != INVALID || reference::closest(&g.scene(), &ray64(&rays[0])).is_none());
 }
 
 #[test]
@@ -737,7 +848,11 @@ fn gpu_far_small_sphere() {
     let ctx = gpu();
     let c = DVec3::new(1e4, 3e3, -2e3);
     let r = 0.01;
-    let g = Geometry { tris: vec![], spheres: vec![GpuSphere { center: c.as_vec3().into(), radius: r as f32, ..Default::default() }], quads: vec![] };
+    let g = Geometry {
+        tris: vec![],
+        spheres: vec![GpuSphere { center: c.as_vec3().into(), radius: r as f32, ..Default::default() }],
+        quads: vec![],
+    };
     let b = g.build();
     let mut rng = Pcg64::seed_from_u64(21);
     let rays: Vec<ProbeRay> = (0..20_000)
@@ -816,8 +931,14 @@ fn gpu_watertight_through_edges_and_vertices() {
         let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
         let out = gpu_trace(&ctx, &g, &b, &inputs);
         let misses = out.iter().filter(|h| h.prim == INVALID).count();
-        let far = out.iter().zip(&rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-4).count();
-        assert_eq!(misses, 0, "{misses} of {} rays through edges/vertices leaked (mesh at {center}, size {size})", rays.len());
+        let far =
+            out.iter().zip(&rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-4).count();
+        assert_eq!(
+            misses,
+            0,
+            "{misses} of {} rays through edges/vertices leaked (mesh at {center}, size {size})",
+            rays.len()
+        );
         assert_eq!(far, 0, "{far} rays hit away from their aim point (mesh at {center}, size {size})");
     }
 }
@@ -852,7 +973,11 @@ fn gpu_offset_ray_origin_avoids_self_intersection() {
     let mut rng = Pcg64::seed_from_u64(9);
     let mut total = 0;
     // Magnitudes from the float-offset region around the origin up to 1e5, both signs.
-    for (k, &(mag, cell)) in [(0.0f32, 0.01f32), (0.05, 0.01), (1.0, 0.1), (300.0, 1.0), (2e4, 10.0), (1e5, 10.0), (1e5, 0.5)].iter().enumerate() {
+    for (k, &(mag, cell)) in
+        [(0.0f32, 0.01f32), (0.05, 0.01), (1.0, 0.1), (300.0, 1.0), (2e4, 10.0), (1e5, 10.0), (1e5, 0.5)]
+            .iter()
+            .enumerate()
+    {
         let center = if mag == 0.0 { Vec3::ZERO } else { unit(&mut rng).as_vec3() * mag };
         let tris = wavy_mesh(center, cell, 32, &mut rng);
         let g = Geometry { tris, spheres: vec![], quads: vec![] };
@@ -870,7 +995,11 @@ fn gpu_offset_ray_origin_avoids_self_intersection() {
                 let side = if rng.random::<bool>() { 1.0 } else { -1.0 };
                 let ng = (v1 - v0).cross(v2 - v0).normalize() * side;
                 // Cosine-distributed, plus grazing directions.
-                let cos = if rng.random::<f32>() < 0.3 { rng.random_range(1e-4..0.02f32) } else { rng.random::<f32>().sqrt().max(1e-4) };
+                let cos = if rng.random::<f32>() < 0.3 {
+                    rng.random_range(1e-4..0.02f32)
+                } else {
+                    rng.random::<f32>().sqrt().max(1e-4)
+                };
                 let t = ng.any_orthonormal_vector();
                 let bt = ng.cross(t);
                 let phi = rng.random_range(0.0..6.2831f32);
@@ -881,21 +1010,33 @@ fn gpu_offset_ray_origin_avoids_self_intersection() {
             .collect();
         let inputs: Vec<ProbeSpawn> = spawns.iter().map(|s| s.1).collect();
         let buffers = GeometryBuffers::new(&ctx, &b, &g.tris, &g.spheres, &g.quads);
-        let out: Vec<ProbeSpawnOut> =
-            Probe::new(&ctx).map(&probe_source(), "ProbeSpawn", "ProbeSpawnOut", "probe_spawn", &inputs, Some(&buffers)).unwrap_or_else(|e| panic!("{e}"));
+        let out: Vec<ProbeSpawnOut> = Probe::new(&ctx)
+            .map(&probe_source(), "ProbeSpawn", "ProbeSpawnOut", "probe_spawn", &inputs, Some(&buffers))
+            .unwrap_or_else(|e| panic!("{e}"));
         let mut self_hits = 0;
         for ((i, s), o) in spawns.iter().zip(&out) {
             let own = make_prim(PRIM_TRIANGLE, *i as u32);
             // The origin must have moved to the leaving side of the plane...
             let [v0, v1, v2] = g.tris[*i].map(|v| v.as_dvec3());
-            let n = (v1 - v0).cross(v2 - v0).normalize() * Vec3::from(s.ng).as_dvec3().dot((v1 - v0).cross(v2 - v0)).signum();
-            assert!((Vec3::from(o.o).as_dvec3() - v0).dot(n) > 0.0, "case {k}: offset origin {:?} is not above the plane (p {:?})", o.o, s.p);
+            let n = (v1 - v0).cross(v2 - v0).normalize()
+                * Vec3::from(s.ng).as_dvec3().dot((v1 - v0).cross(v2 - v0)).signum();
+            assert!(
+                (Vec3::from(o.o).as_dvec3() - v0).dot(n) > 0.0,
+                "case {k}: offset origin {:?} is not above the plane (p {:?})",
+                o.o,
+                s.p
+            );
             // ...and the ray must not hit its own triangle.
             if o.prim == own {
                 self_hits += 1;
             }
         }
-        assert_eq!(self_hits, 0, "case {k} (|p| ~ {mag}): {self_hits} of {} spawned rays re-hit their own triangle", spawns.len());
+        assert_eq!(
+            self_hits,
+            0,
+            "case {k} (|p| ~ {mag}): {self_hits} of {} spawned rays re-hit their own triangle",
+            spawns.len()
+        );
         total += spawns.len();
     }
     eprintln!("offset_ray_origin: {total} spawned rays, no self-intersections");
@@ -924,12 +1065,31 @@ fn probe_reports_sentinel_and_shader_errors() {
         })
         .unwrap();
     let out: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-    assert_eq!(out, vec![0, mislab::probe::PROBE_SENTINEL, 4, mislab::probe::PROBE_SENTINEL, 8, mislab::probe::PROBE_SENTINEL, 12, mislab::probe::PROBE_SENTINEL]);
+    assert_eq!(
+        out,
+        vec![
+            0,
+            mislab::probe::PROBE_SENTINEL,
+            4,
+            mislab::probe::PROBE_SENTINEL,
+            8,
+            mislab::probe::PROBE_SENTINEL,
+            12,
+            mislab::probe::PROBE_SENTINEL
+        ]
+    );
     // A map over more elements than one dispatch row would hold is not needed here; check a plain map and errors.
-    let doubled: Vec<f32> = probe.map("fn twice(x: f32) -> f32 { return 2.0 * x; }", "f32", "f32", "twice", &[1.0f32, 2.5, -3.0], None).unwrap();
+    let doubled: Vec<f32> = probe
+        .map("fn twice(x: f32) -> f32 { return 2.0 * x; }", "f32", "f32", "twice", &[1.0f32, 2.5, -3.0], None)
+        .unwrap();
     assert_eq!(doubled, vec![2.0, 5.0, -6.0]);
-    let err = probe.map::<f32, f32>("fn twice(x: f32) -> f32 { return 2.0 * y; }", "f32", "f32", "twice", &[1.0], None).unwrap_err();
+    // More elements than one row of 65535 workgroups holds: the 2D dispatch must cover every one exactly once.
+    let many: Vec<u32> = (0..65_535 * 64 + 1000).collect();
+    let out: Vec<u32> =
+        probe.map("fn f(x: u32) -> u32 { return 3u * x + 1u; }", "u32", "u32", "f", &many, None).unwrap();
+    assert!(out.iter().zip(&many).all(|(o, x)| *o == 3 * x + 1), "2D dispatch missed elements");
+    let err = probe
+        .map::<f32, f32>("fn twice(x: f32) -> f32 { return 2.0 * y; }", "f32", "f32", "twice", &[1.0], None)
+        .unwrap_err();
     assert!(err.to_string().contains("y"), "{err}");
 }
-
-
