@@ -193,8 +193,10 @@ struct FrameParams {
     env_width: u32,
     env_height: u32,
     sampler_spp: u32,
-    _pad0: u32,
-    _pad1: u32,
+    /// First film row this dispatch renders (the viewer renders bands of rows to bound its frame time).
+    row_offset: u32,
+    /// Rows this dispatch renders from `row_offset` (the dispatch covers ceil(row_count / 8) workgroup rows).
+    row_count: u32,
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;

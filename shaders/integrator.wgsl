@@ -58,9 +58,12 @@ fn radiance(px: vec2<u32>, id: SampleId) -> vec3<f32> {
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn render_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.width || gid.y >= params.height) { return; }
-    let pixel = gid.y * params.width + gid.x;
+fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    bvh_set_lane(lid);
+    // The dispatch covers rows [row_offset, row_offset + row_count) of the film.
+    let px = vec2<u32>(gid.x, gid.y + params.row_offset);
+    if (px.x >= params.width || gid.y >= params.row_count || px.y >= params.height) { return; }
+    let pixel = px.y * params.width + px.x;
     // Welford's update, one sample at a time: the mean moves by (x − mean)/n, a small correction, so it
     // stays accurate without a compensated (Kahan) sum — which lavapipe's reassociation would erase —
     // and the result does not depend on how samples are split into dispatches (bit-for-bit repeatable).
@@ -68,7 +71,7 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var bad = 0u;
     for (var i = 0u; i < min(params.samples_per_dispatch, 65536u); i += 1u) {
         let id = SampleId(pixel, params.sample_base + i);
-        let v = radiance(gid.xy, id);
+        let v = radiance(px, id);
         if (any_nonfinite3(v)) { bad += 1u; continue; }
         a.count += 1u;
         let delta = v - a.mean;

@@ -268,10 +268,11 @@ fn directional_sample_li(l: Light) -> LightSample {
 // ---- environment ----
 
 /// Direction → equirectangular (u, v) in map space: u = 0.5 looks down −Z, v = 0 is +Y;
-/// the map is rotated by `env_rotation` radians about +Y. θ from atan2 (acos(w.y) loses digits at the poles).
+/// the map is rotated by `env_rotation` radians about +Y. θ from atan2 (acos(w.y) loses digits at the poles), and
+/// the accurate atan2 so that directions map to the texels `env_sample_li` sampled them in.
 fn env_direction_to_uv(w: vec3<f32>) -> vec2<f32> {
-    let u = atan2(w.x, -w.z) * INV_TWO_PI + 0.5 - params.env_rotation * INV_TWO_PI;
-    return vec2<f32>(fract(u), atan2(length(w.xz), w.y) * INV_PI);
+    let u = atan2_accurate(w.x, -w.z) * INV_TWO_PI + 0.5 - params.env_rotation * INV_TWO_PI;
+    return vec2<f32>(fract(u), atan2_accurate(length(w.xz), w.y) * INV_PI);
 }
 
 fn env_uv_to_direction(uv: vec2<f32>) -> vec3<f32> {
@@ -307,22 +308,24 @@ fn env_pdf(w: vec3<f32>) -> f32 {
 
 /// Environment: uniform on the sphere, or a texel ∝ luminance·sinθ by the alias table (column from u.z, coin
 /// from u.y, which is then reused) and uniform in (u, v) inside the texel, so pdf_ω = density_uv / (2π² sinθ).
+/// The pdf returned is the chosen texel's: at a texel edge, f32 rounding may map the direction into the
+/// neighbour, where `env_pdf` (and a black neighbour's radiance) would differ on that measure-zero set.
 /// Measure: solid angle.
 fn env_sample_li(u: vec3<f32>) -> LightSample {
-    var wi: vec3<f32>;
     if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) {
-        wi = square_to_uniform_sphere(u.xy);
-    } else {
-        let n = params.env_width * params.env_height;
-        let pick = alias_sample2(0u, n, u.z, u.y, true);
-        let x = pick.index % params.env_width;
-        let y = pick.index / params.env_width;
-        let uv = vec2<f32>((f32(x) + u.x) / f32(params.env_width), (f32(y) + pick.u) / f32(params.env_height));
-        wi = env_uv_to_direction(uv);
+        let wi = square_to_uniform_sphere(u.xy);
+        return LightSample(wi, F32_MAX, env_eval(wi), INV_FOUR_PI, false);
     }
-    let pdf = env_pdf(wi);
+    let n = params.env_width * params.env_height;
+    let pick = alias_sample2(0u, n, u.z, u.y, true);
+    let x = pick.index % params.env_width;
+    let y = pick.index / params.env_width;
+    let uv = vec2<f32>((f32(x) + u.x) / f32(params.env_width), (f32(y) + pick.u) / f32(params.env_height));
+    let wi = env_uv_to_direction(uv);
+    let texel = env_texels[pick.index];
+    let pdf = texel.w / (2.0 * PI * PI * max(length(wi.xz), 1e-7));
     if (!(pdf > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, F32_MAX, env_eval(wi), pdf, false);
+    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, false);
 }
 
 // ---- the light technique as a whole ----

@@ -86,6 +86,30 @@ fn square_to_uniform_triangle(u: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(b1, 1.0 - b0 - b1);
 }
 
+// ---- accurate arctangent ----
+
+/// atan2(y, x) to ~2 ulp. The driver's atan/atan2 may be far less accurate (Vulkan allows 4096 ulp; lavapipe's is
+/// off by up to 2.1e-5 relative, 2e-6 absolute — measured in tests/sampling.rs), which the solid-angle code below
+/// cannot afford. Cephes' atanf: reduction to [0, 1] by the octant, to |t| ≤ tan(π/8) by (t − 1)/(t + 1), and a
+/// degree-9 odd polynomial. atan2(0, 0) = 0.
+fn atan2_accurate(y: f32, x: f32) -> f32 {
+    let ax = abs(x);
+    let ay = abs(y);
+    let hi = max(ax, ay);
+    if (!(hi > 0.0)) { return 0.0; }
+    var t = min(ax, ay) / hi;
+    var base = 0.0;
+    if (t > 0.41421356) {
+        t = (t - 1.0) / (t + 1.0);
+        base = 0.78539816;
+    }
+    let z = t * t;
+    var a = base + (((0.0805374449538 * z - 0.138776856032) * z + 0.199777106478) * z - 0.333329491539) * z * t + t;
+    if (ay > ax) { a = 1.57079633 - a; }
+    if (x < 0.0) { a = PI - a; }
+    return select(a, -a, y < 0.0);
+}
+
 // ---- spherical polygons (solid-angle sampling of triangle and rectangle lights) ----
 //
 // Both warps take the polygon's vertices RELATIVE TO THE SHADING POINT (unnormalised) and are written so that
@@ -104,7 +128,7 @@ fn spherical_triangle_solid_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f
     let lc = length(c);
     let det = dot(a, cross(b - a, c - a)) / (la * lb * lc);
     let den = 1.0 + dot(a, b) / (la * lb) + dot(b, c) / (lb * lc) + dot(c, a) / (lc * la);
-    return 2.0 * atan2(abs(det), den);
+    return 2.0 * atan2_accurate(abs(det), den);
 }
 
 /// Uniform over the spherical triangle (a, b, c) seen from the origin (vertices relative to the viewpoint).
@@ -130,7 +154,7 @@ fn square_to_spherical_triangle(u: vec2<f32>, a: vec3<f32>, b: vec3<f32>, c: vec
     let k = 1.0 + dot(an, bn);
     let half = 0.5 * u.x * omega;
     let sh = sin(half);
-    let half_phi = atan2(k * sh, d * cos(half) - e * sh);
+    let half_phi = atan2_accurate(k * sh, d * cos(half) - e * sh);
     let s_half = sin(half_phi);
     // ĉ′ − b̂ = (â − b̂) + (cosφ − 1)·â + sinφ·ŵ, with cosφ − 1 = −2 sin²(φ/2).
     let delta = (an - bn) - (2.0 * s_half * s_half) * an + sin(2.0 * half_phi) * w;
@@ -145,58 +169,87 @@ fn square_to_spherical_triangle_pdf(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) ->
 }
 
 /// A rectangle prepared for solid-angle sampling, in its local frame: the viewpoint at the origin, the rectangle
-/// [x0, x1] × [y0, y1] in the plane z = −h (h > 0). `beta_sum` = β0 + β1 and `beta_diff` = β1 − β0, with
-/// βi = atan2(yi, h) the elevation of edge y = yi; `psi0`, `psi1` = ψ(x0), ψ(x1) (see below); `omega` = Ω.
+/// [x0, x1] × [y0, y1] in the plane z = −h (h > 0). Sampling picks the coordinate along axis "a" first, then along
+/// "b": (a, b) = (x, y), or (y, x) when `swap` (see `spherical_rect_setup`). With βi the elevation of the edge b = bi:
+/// `cos_pair` holds what cos((Σ ± ψ)/2) (Σ = β0 + β1) needs, `beta_diff` = β1 − β0, `psi0`/`psi1` = ψ(a0), ψ(a1);
+/// `omega` = Ω.
 struct SphericalRect {
     x0: f32,
-    x1: f32,
     y0: f32,
-    y1: f32,
+    a0: f32,
+    a1: f32,
+    b0: f32,
+    b1: f32,
     h: f32,
-    beta_sum: f32,
+    /// Σ = β0 + β1 when b0 < 0 < b1 (cos((Σ ± ψ)/2) directly); else Γ = atan(h/|b0|) + atan(h/|b1|), the
+    /// complement of |Σ| (cos((Σ ± ψ)/2) = sin((Γ ∓ ψ)/2), no cancellation when h ≪ |bi|).
+    cos_pair: f32,
+    straddles: bool,
     beta_diff: f32,
     psi0: f32,
     psi1: f32,
+    swap: bool,
     omega: f32,
 }
 
-/// ψ(X): the signed solid angle of the strip [0, X] × [y0, y1] at depth h,
-/// atan(X·y1/(h·R1)) − atan(X·y0/(h·R0)) with Ri = |(X, yi, h)|, as one atan2 whose y1·R0 − y0·R1 is rationalised
-/// when y0, y1 have the same sign (it cancels for small rectangles otherwise).
-fn spherical_rect_psi(x: f32, y0: f32, y1: f32, h: f32) -> f32 {
-    let r0 = sqrt(x * x + y0 * y0 + h * h);
-    let r1 = sqrt(x * x + y1 * y1 + h * h);
-    var m = y1 * r0 - y0 * r1;
-    if (y0 * y1 > 0.0) { m = (x * x + h * h) * (y1 - y0) * (y1 + y0) / (y1 * r0 + y0 * r1); }
-    return atan2(x * h * m, h * h * r0 * r1 + x * x * y0 * y1);
+/// ψ(A): the signed solid angle of the strip [0, A] × [b0, b1] at depth h,
+/// atan(A·b1/(h·R1)) − atan(A·b0/(h·R0)) with Ri = |(A, bi, h)|, as one atan2 whose b1·R0 − b0·R1 is rationalised
+/// when b0, b1 have the same sign (it cancels for small rectangles otherwise).
+fn spherical_rect_psi(a: f32, b0: f32, b1: f32, h: f32) -> f32 {
+    let r0 = sqrt(a * a + b0 * b0 + h * h);
+    let r1 = sqrt(a * a + b1 * b1 + h * h);
+    var m = b1 * r0 - b0 * r1;
+    if (b0 * b1 > 0.0) { m = (a * a + h * h) * (b1 - b0) * (b1 + b0) / (b1 * r0 + b0 * r1); }
+    return atan2_accurate(a * h * m, h * h * r0 * r1 + a * a * b0 * b1);
 }
 
-/// Local coordinates of a rectangle light seen from the origin; `h` must be > 0 (the caller checks the side).
+/// Prepares the rectangle [x0, x0 + w] × [y0, y0 + hgt] at depth h > 0 (the caller checks the side). The first
+/// axis is the one whose range lies nearer the foot of the perpendicular (x = y = 0): with the other axis's range
+/// straddling the foot and the first far from it (a rectangle seen edge-on from beside it), ψ(a0) and ψ(a1) would
+/// both be near ±π and Ω their small difference.
 fn spherical_rect_setup(x0: f32, y0: f32, w: f32, hgt: f32, h: f32) -> SphericalRect {
     var r: SphericalRect;
     r.x0 = x0;
-    r.x1 = x0 + w;
     r.y0 = y0;
-    r.y1 = y0 + hgt;
     r.h = h;
-    r.beta_sum = atan2(r.y0, h) + atan2(r.y1, h);
-    // β1 − β0: the angle between (y0, h) and (y1, h), from the edge length (no cancellation).
-    r.beta_diff = atan2(h * hgt, h * h + r.y0 * r.y1);
-    r.psi0 = spherical_rect_psi(r.x0, r.y0, r.y1, h);
-    r.psi1 = spherical_rect_psi(r.x1, r.y0, r.y1, h);
+    let dx = max(max(x0, -(x0 + w)), 0.0);
+    let dy = max(max(y0, -(y0 + hgt)), 0.0);
+    r.swap = dx > dy;
+    var la = w;
+    var lb = hgt;
+    r.a0 = x0;
+    r.b0 = y0;
+    if (r.swap) {
+        la = hgt;
+        lb = w;
+        r.a0 = y0;
+        r.b0 = x0;
+    }
+    r.a1 = r.a0 + la;
+    r.b1 = r.b0 + lb;
+    r.straddles = r.b0 < 0.0 && r.b1 > 0.0;
+    if (r.straddles) {
+        r.cos_pair = atan2_accurate(r.b0, h) + atan2_accurate(r.b1, h);
+    } else {
+        r.cos_pair = atan2_accurate(h, abs(r.b0)) + atan2_accurate(h, abs(r.b1));
+    }
+    // β1 − β0: the angle between (b0, h) and (b1, h), from the edge length (no cancellation).
+    r.beta_diff = atan2_accurate(h * lb, h * h + r.b0 * r.b1);
+    r.psi0 = spherical_rect_psi(r.a0, r.b0, r.b1, h);
+    r.psi1 = spherical_rect_psi(r.a1, r.b0, r.b1, h);
     // Ω: two Van Oosterom–Strackee triangles; both triple products equal h·w·hgt exactly.
-    let v00 = vec3<f32>(r.x0, r.y0, -h);
-    let v10 = vec3<f32>(r.x1, r.y0, -h);
-    let v11 = vec3<f32>(r.x1, r.y1, -h);
-    let v01 = vec3<f32>(r.x0, r.y1, -h);
+    let v00 = vec3<f32>(x0, y0, -h);
+    let v10 = vec3<f32>(x0 + w, y0, -h);
+    let v11 = vec3<f32>(x0 + w, y0 + hgt, -h);
+    let v01 = vec3<f32>(x0, y0 + hgt, -h);
     let l00 = length(v00);
     let l10 = length(v10);
     let l11 = length(v11);
     let l01 = length(v01);
     let vol = h * w * hgt;
     let c0011 = dot(v00, v11) / (l00 * l11);
-    let t1 = atan2(vol / (l00 * l10 * l11), 1.0 + dot(v00, v10) / (l00 * l10) + dot(v10, v11) / (l10 * l11) + c0011);
-    let t2 = atan2(vol / (l00 * l11 * l01), 1.0 + c0011 + dot(v11, v01) / (l11 * l01) + dot(v01, v00) / (l01 * l00));
+    let t1 = atan2_accurate(vol / (l00 * l10 * l11), 1.0 + dot(v00, v10) / (l00 * l10) + dot(v10, v11) / (l10 * l11) + c0011);
+    let t2 = atan2_accurate(vol / (l00 * l11 * l01), 1.0 + c0011 + dot(v11, v01) / (l11 * l01) + dot(v01, v00) / (l01 * l00));
     r.omega = 2.0 * (t1 + t2);
     return r;
 }
@@ -204,29 +257,35 @@ fn spherical_rect_setup(x0: f32, y0: f32, w: f32, hgt: f32, h: f32) -> Spherical
 /// Uniform over the spherical rectangle `r` (from `spherical_rect_setup`), returned as the local point
 /// (x, y) on the rectangle (the direction is normalize((x, y, −h))). Measure: solid angle, pdf 1/Ω.
 /// Ureña, Fajardo & King 2013, "An Area-Preserving Parametrization for Spherical Rectangles": u.x picks the
-/// sub-rectangle [x0, x] of solid angle u.x·Ω, u.y a point on the segment at x uniform in y/|(x, y, h)|.
-/// Reformulated for f32: the paper's angle sum minus π at the edge x is ψ(x) (`spherical_rect_psi`), so
-/// ψ = lerp(ψ(x0), ψ(x1), u.x) and, solving the paper's eqs. for x with half-angle identities,
-///   x = h·sinψ / (2·sqrt(cos((Σ+ψ)/2)·cos((Σ−ψ)/2)·sin((Δ−ψ)/2)·sin((Δ+ψ)/2))),  Σ = β0 + β1, Δ = β1 − β0,
+/// sub-rectangle [a0, a] of solid angle u.x·Ω, u.y a point on the segment at a uniform in b/|(a, b, h)|.
+/// Reformulated for f32: the paper's angle sum minus π at the edge a is ψ(a) (`spherical_rect_psi`), so
+/// ψ = lerp(ψ(a0), ψ(a1), u.x) and, solving the paper's eqs. for a with half-angle identities,
+///   a = h·sinψ / (2·sqrt(cos((Σ+ψ)/2)·cos((Σ−ψ)/2)·sin((Δ−ψ)/2)·sin((Δ+ψ)/2))),  Σ = β0 + β1, Δ = β1 − β0,
 /// a product without cancellation; in step 2, 1 ∓ hv are interpolated from 1 ∓ hi computed without cancellation,
 /// so grazing rectangles (hv → ±1) keep their precision.
 fn square_to_spherical_rectangle(u: vec2<f32>, r: SphericalRect) -> vec2<f32> {
     let psi = mix(r.psi0, r.psi1, u.x);
-    let q = cos(0.5 * (r.beta_sum + psi)) * cos(0.5 * (r.beta_sum - psi)) * sin(0.5 * (r.beta_diff - psi)) * sin(0.5 * (r.beta_diff + psi));
-    let x = clamp(r.h * sin(psi) / (2.0 * sqrt(max(q, 0.0))), r.x0, r.x1);
-    let dd2 = x * x + r.h * r.h;
-    let r0 = sqrt(dd2 + r.y0 * r.y0);
-    let r1 = sqrt(dd2 + r.y1 * r.y1);
-    let h0 = r.y0 / r0;
-    let h1 = r.y1 / r1;
-    // 1 − hi and 1 + hi without cancellation: 1 − y/r = dd²/(r (r + y)) for y > 0, and symmetrically.
-    let om0 = select(1.0 - h0, dd2 / (r0 * (r0 + r.y0)), r.y0 > 0.0);
-    let om1 = select(1.0 - h1, dd2 / (r1 * (r1 + r.y1)), r.y1 > 0.0);
-    let op0 = select(1.0 + h0, dd2 / (r0 * (r0 - r.y0)), r.y0 < 0.0);
-    let op1 = select(1.0 + h1, dd2 / (r1 * (r1 - r.y1)), r.y1 < 0.0);
+    var cc: f32;
+    if (r.straddles) {
+        cc = cos(0.5 * (r.cos_pair + psi)) * cos(0.5 * (r.cos_pair - psi));
+    } else {
+        cc = sin(0.5 * (r.cos_pair + psi)) * sin(0.5 * (r.cos_pair - psi));
+    }
+    let q = cc * sin(0.5 * (r.beta_diff - psi)) * sin(0.5 * (r.beta_diff + psi));
+    let a = clamp(r.h * sin(psi) / (2.0 * sqrt(max(q, 0.0))), r.a0, r.a1);
+    let dd2 = a * a + r.h * r.h;
+    let r0 = sqrt(dd2 + r.b0 * r.b0);
+    let r1 = sqrt(dd2 + r.b1 * r.b1);
+    let h0 = r.b0 / r0;
+    let h1 = r.b1 / r1;
+    // 1 − hi and 1 + hi without cancellation: 1 − b/r = dd²/(r (r + b)) for b > 0, and symmetrically.
+    let om0 = select(1.0 - h0, dd2 / (r0 * (r0 + r.b0)), r.b0 > 0.0);
+    let om1 = select(1.0 - h1, dd2 / (r1 * (r1 + r.b1)), r.b1 > 0.0);
+    let op0 = select(1.0 + h0, dd2 / (r0 * (r0 - r.b0)), r.b0 < 0.0);
+    let op1 = select(1.0 + h1, dd2 / (r1 * (r1 - r.b1)), r.b1 < 0.0);
     let hv = mix(h0, h1, u.y);
     let one_minus_hv2 = mix(om0, om1, u.y) * mix(op0, op1, u.y);
-    let y = clamp(hv * sqrt(dd2) / sqrt(one_minus_hv2), r.y0, r.y1);
-    return vec2<f32>(x, y);
+    let b = clamp(hv * sqrt(dd2) / sqrt(one_minus_hv2), r.b0, r.b1);
+    return select(vec2<f32>(a, b), vec2<f32>(b, a), r.swap);
 }
 fn square_to_spherical_rectangle_pdf(r: SphericalRect) -> f32 { return 1.0 / r.omega; }

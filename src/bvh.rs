@@ -166,7 +166,7 @@ pub fn triangle_aabb(v: &[Vec3; 3]) -> Option<Aabb> {
 /// The box of a sphere (rounded outwards), or `None` if excluded (non-finite, radius not > 0).
 pub fn sphere_aabb(s: &GpuSphere) -> Option<Aabb> {
     let c = Vec3::from(s.center);
-    if !finite3(c) || !(s.radius > 0.0) || !s.radius.is_finite() {
+    if !finite3(c) || s.radius.is_nan() || s.radius <= 0.0 || !s.radius.is_finite() {
         return None;
     }
     let b = outward(c - s.radius, c + s.radius);

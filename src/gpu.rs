@@ -210,6 +210,7 @@ pub fn describe(ctx: &GpuContext) -> String {
     s += &format!("  max storage buffers per stage: {}\n", l.max_storage_buffers_per_shader_stage);
     s += &format!("  max workgroups per dimension: {}\n", l.max_compute_workgroups_per_dimension);
     s += &format!("  max invocations per workgroup: {}\n", l.max_compute_invocations_per_workgroup);
+    s += &format!("  max workgroup storage: {} KiB\n", l.max_compute_workgroup_storage_size >> 10);
     s += &format!("  timestamp queries: {}\n", if ctx.timestamps { "yes" } else { "no" });
     s
 }

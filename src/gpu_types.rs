@@ -177,8 +177,10 @@ pub struct GpuFrameParams {
     pub env_width: u32,
     pub env_height: u32,
     pub sampler_spp: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// First film row of the dispatch.
+    pub row_offset: u32,
+    /// Rows rendered from `row_offset`.
+    pub row_count: u32,
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

@@ -17,3 +17,4 @@ pub mod settings;
 pub mod progressive;
 pub mod features;
 pub mod chi2;
+pub mod viewer;

@@ -237,7 +237,7 @@ impl<'a> Probe<'a> {
         }
         let n = inputs.len() as u64;
         assert!(n <= u32::MAX as u64, "too many probe inputs");
-        let source = format!("{library}\n{}", map_kernel(in_type, out_type, function));
+        let source = format!("{library}\n{}", map_kernel(in_type, out_type, function, library.contains("fn bvh_set_lane")));
         let groups = n.div_ceil(MAP_WORKGROUP_SIZE as u64) as u32;
         let max = self.ctx.limits().max_compute_workgroups_per_dimension.max(1);
         let workgroups = [groups.min(max), groups.div_ceil(max), 1];
@@ -257,13 +257,16 @@ impl<'a> Probe<'a> {
 /// The WGSL of a kernel `probe_map` that writes `probe_out[i] = function(probe_in[i])` for i < `PROBE_COUNT`
 /// (an `override`), with the group-1 declarations of the binding convention. Dispatch is 2D when the element count
 /// needs more than the per-dimension workgroup limit.
-pub fn map_kernel(in_type: &str, out_type: &str, function: &str) -> String {
+pub fn map_kernel(in_type: &str, out_type: &str, function: &str, traces: bool) -> String {
+    // Kernels that trace rays tell the traversal which workgroup-stack slice is theirs.
+    let set_lane = if traces { "bvh_set_lane(lid);" } else { "" };
     format!(
         "override PROBE_COUNT: u32;
 @group(1) @binding(0) var<storage, read_write> probe_out: array<{out_type}>;
 @group(1) @binding(1) var<storage, read> probe_in: array<{in_type}>;
 @compute @workgroup_size({MAP_WORKGROUP_SIZE})
-fn probe_map(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {{
+fn probe_map(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {{
+    {set_lane}
     let i = gid.x + gid.y * nwg.x * {MAP_WORKGROUP_SIZE}u;
     if i >= PROBE_COUNT {{ return; }}
     probe_out[i] = {function}(probe_in[i]);

@@ -72,6 +72,15 @@ pub struct Renderer {
 impl Renderer {
     /// Builds the pipeline and the per-render buffers for `scene` at the settings' film size.
     pub fn new(ctx: &GpuContext, scene: &GpuScene, camera: Camera, settings: Settings) -> Result<Renderer, String> {
+        let mut r = Renderer::new_unprepared(ctx, scene, camera, settings)?;
+        r.prepare()?;
+        r.warm_up(ctx).map_err(|e| e.to_string())?;
+        Ok(r)
+    }
+
+    /// The per-render buffers only, with no pipeline yet: the viewer compiles pipelines on another
+    /// thread and hands them in with `insert_pipeline` (compiling takes seconds on lavapipe).
+    pub fn new_unprepared(ctx: &GpuContext, scene: &GpuScene, camera: Camera, settings: Settings) -> Result<Renderer, String> {
         settings.validate()?;
         let device = ctx.device.clone();
         let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
@@ -175,9 +184,23 @@ impl Renderer {
             num_lights: d.lights.len() as u32,
         };
         r.reset();
-        r.prepare()?;
-        r.warm_up(ctx).map_err(|e| e.to_string())?;
         Ok(r)
+    }
+
+    /// The layout every render pipeline of this renderer uses (to build one on another thread).
+    pub fn pipeline_layout(&self) -> &wgpu::PipelineLayout {
+        &self.pipeline_layout
+    }
+
+    /// Whether the pipeline for `key` is built.
+    pub fn has_pipeline(&self, key: &PipelineKey) -> bool {
+        self.pipelines.contains_key(key)
+    }
+
+    /// Adds a pipeline built elsewhere with a layout equal to `pipeline_layout()` (wgpu deduplicates
+    /// equal bind group layouts, so renderers of scenes with the same bindings can share pipelines).
+    pub fn insert_pipeline(&mut self, key: PipelineKey, pipeline: wgpu::ComputePipeline) {
+        self.pipelines.insert(key, pipeline);
     }
 
     /// The pipeline key the current settings need.
@@ -276,24 +299,40 @@ impl Renderer {
             env_width: self.env_size.0,
             env_height: self.env_size.1,
             sampler_spp: 0,
-            _pad0: 0,
-            _pad1: 0,
+            row_offset: 0,
+            row_count: s.height,
         }
     }
 
     /// Records one dispatch of `spp` samples per pixel into `enc` and advances the sample count.
     /// The parameters are written to the queue first, so call `submit` before recording another.
     pub fn encode(&mut self, enc: &mut wgpu::CommandEncoder, spp: u32) {
-        let p = self.frame_params(spp);
+        self.encode_rows(enc, spp, 0, self.settings.height, None);
+        self.samples += spp;
+    }
+
+    /// Records a dispatch of `spp` samples per pixel for film rows `row_offset .. row_offset + row_count`
+    /// only, starting at sample index `samples`, WITHOUT advancing `samples`: the caller adds `spp` once
+    /// every row has had them (the viewer renders a pass in bands of rows to bound its frame time).
+    /// `timestamps`, when given, brackets the pass with GPU timestamps. Call `submit` before recording another.
+    pub fn encode_rows(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        spp: u32,
+        row_offset: u32,
+        row_count: u32,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let row_offset = row_offset.min(self.settings.height);
+        let row_count = row_count.min(self.settings.height - row_offset);
+        let p = GpuFrameParams { row_offset, row_count, ..self.frame_params(spp) };
         self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: None });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: timestamps });
         let pipeline = self.pipelines.get(&self.key()).expect("prepare() builds the pipeline before encoding");
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.scene_group, &[]);
         pass.set_bind_group(1, &self.frame_group, &[]);
-        pass.dispatch_workgroups(self.settings.width.div_ceil(8), self.settings.height.div_ceil(8), 1);
-        drop(pass);
-        self.samples += spp;
+        pass.dispatch_workgroups(self.settings.width.div_ceil(8), row_count.div_ceil(8), 1);
     }
 
     /// Renders `spp` more samples per pixel in one submission and waits for them (with the device timeout).

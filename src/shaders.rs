@@ -17,6 +17,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("mis.wgsl", include_str!("../shaders/mis.wgsl")),
     ("estimators.wgsl", include_str!("../shaders/estimators.wgsl")),
     ("integrator.wgsl", include_str!("../shaders/integrator.wgsl")),
+    ("display.wgsl", include_str!("../shaders/display.wgsl")),
 ];
 
 /// The source of one embedded file.

@@ -872,7 +872,7 @@ fn gpu_far_small_sphere() {
 /// A closed, bumpy "cube sphere": six n×n grids whose vertices are a function of their integer lattice point, so
 /// the vertices shared across faces are bit-identical. Rotated randomly, scaled by `size`, moved to `center`.
 fn closed_mesh(n: i32, size: f32, center: Vec3, rng: &mut Pcg64) -> Vec<[Vec3; 3]> {
-    let rot = glam::Quat::from_axis_angle(unit(rng).as_vec3(), rng.random_range(0.0..6.28));
+    let rot = glam::Quat::from_axis_angle(unit(rng).as_vec3(), rng.random_range(0.0..std::f32::consts::TAU));
     let vert = |p: glam::IVec3| {
         let c = (p.as_vec3() / n as f32) * 2.0 - 1.0;
         let bump = 1.0 + 0.15 * (3.0 * c.x).sin() * (2.0 * c.y).cos() * (2.5 * c.z + 1.0).sin();
@@ -949,7 +949,7 @@ fn gpu_watertight_through_edges_and_vertices() {
 /// A wavy grid mesh of `n`×`n` cells of size `cell`, rotated randomly and centred at `center`.
 fn wavy_mesh(center: Vec3, cell: f32, n: usize, rng: &mut Pcg64) -> Vec<[Vec3; 3]> {
     let axis = unit(rng).as_vec3();
-    let rot = glam::Quat::from_axis_angle(axis, rng.random_range(0.0..6.28));
+    let rot = glam::Quat::from_axis_angle(axis, rng.random_range(0.0..std::f32::consts::TAU));
     let vert = |i: usize, j: usize| {
         let x = (i as f32 - n as f32 / 2.0) * cell;
         let z = (j as f32 - n as f32 / 2.0) * cell;
@@ -1002,7 +1002,7 @@ fn gpu_offset_ray_origin_avoids_self_intersection() {
                 };
                 let t = ng.any_orthonormal_vector();
                 let bt = ng.cross(t);
-                let phi = rng.random_range(0.0..6.2831f32);
+                let phi = rng.random_range(0.0..std::f32::consts::TAU);
                 let sin = (1.0 - cos * cos).sqrt();
                 let d = (ng * cos + (t * phi.cos() + bt * phi.sin()) * sin).normalize();
                 (i, ProbeSpawn { p: p.into(), ng: ng.into(), d: d.into(), ..Default::default() })
