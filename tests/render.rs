@@ -69,3 +69,24 @@ fn sample_counts_and_variance_are_consistent() {
     assert!(film.count.iter().all(|&c| c == 20), "every pixel must hold 20 samples");
     assert!(film.m2.iter().flatten().all(|&m| m >= 0.0 && m.is_finite()));
 }
+
+/// The device counts non-finite samples (by their bits: `x != x` misses NaN on lavapipe) and leaves them
+/// out of the mean. A light of radiance 3e38 overflows f32 in the estimator, so some
+/// samples are +Inf: they must be counted, per pixel and in total, and the image must stay finite.
+#[test]
+fn nonfinite_samples_are_counted_and_excluded() {
+    let ctx = gpu();
+    let mut scene = scene("furnace");
+    scene.environment = mislab::scene::Environment::None;
+    scene.materials.push(mislab::scene::Material::emitter("huge", glam::Vec3::splat(3.0e38)));
+    let m = (scene.materials.len() - 1) as u32;
+    scene.spheres.push(mislab::scene::Sphere { center: glam::Vec3::new(0.0, 3.0, 0.0), radius: 1.0, material: m });
+    let film = render(&ctx, &scene, &Settings { strategy: Strategy::Uniform, ..small(16, 16) }, 4);
+    assert!(film.nonfinite_total > 0, "overflowing samples must be counted");
+    let per_pixel: u64 = film.nonfinite.iter().map(|&n| n as u64).sum();
+    assert_eq!(per_pixel, film.nonfinite_total, "per-pixel and total counters must agree");
+    assert!(film.mean.iter().flatten().all(|v| v.is_finite()), "non-finite samples must not reach the mean");
+    for i in 0..film.count.len() {
+        assert_eq!(film.count[i] + film.nonfinite[i], 4, "every sample is either accumulated or counted");
+    }
+}

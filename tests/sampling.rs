@@ -1284,8 +1284,8 @@ fn spherical_warp_formulas_match_pbrt() {
             .fold(0.0, f64::max);
         assert!(worst < 1e-9, "triangle from {p}: pbrt and ours differ by {worst:.1e}");
     }
-    for [x0, y0, h] in [[-0.3, -0.2, 0.7], [0.5, 0.4, 0.3], [-2.0, -0.3, 0.4], [0.2, -3.0, 1.0], [-0.5, 0.1, 0.01]] {
-        let (w, hgt) = (1.0, 0.6);
+    for [x0, y0, h] in [[-0.3f64, -0.2, 0.7], [0.5, 0.4, 0.3], [-2.0, -0.3, 0.4], [0.2, -3.0, 1.0], [-0.5, 0.1, 0.01]] {
+        let (w, hgt) = (1.0f64, 0.6f64);
         let swap = x0.max(-(x0 + w)).max(0.0) > y0.max(-(y0 + hgt)).max(0.0);
         let worst = (0..(LATTICE * LATTICE) as usize)
             .map(|i| {
