@@ -120,14 +120,27 @@ fn atan2_accurate(y: f32, x: f32) -> f32 {
 // docs/sampling.md — lights.wgsl falls back to area sampling.
 
 /// Solid angle of the triangle with vertices a, b, c (relative to the viewpoint), Van Oosterom & Strackee 1983:
-/// tan(Ω/2) = |â·(b̂×ĉ)| / (1 + â·b̂ + b̂·ĉ + ĉ·â). The triple product is a·((b − a)×(c − a)) / (|a||b||c|),
-/// from the edges, so it keeps full relative precision for small triangles. Range [0, 2π).
+/// tan(Ω/2) = |â·(b̂×ĉ)| / (1 + â·b̂ + b̂·ĉ + ĉ·â). The triple product is a·((b − a)×(c − a)) / (|a||b||c|), from the
+/// edges, so it keeps full relative precision for small triangles; the denominator is regrouped around the most
+/// nearly opposite pair (x̂, ŷ) as |x̂ + ŷ|²/2 + ẑ·(x̂ + ŷ), which keeps it when the viewpoint is near an edge in the
+/// triangle's plane (1 + x̂·ŷ alone would have no digits left). Range [0, 2π).
 fn spherical_triangle_solid_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
     let la = length(a);
     let lb = length(b);
     let lc = length(c);
     let det = dot(a, cross(b - a, c - a)) / (la * lb * lc);
-    let den = 1.0 + dot(a, b) / (la * lb) + dot(b, c) / (lb * lc) + dot(c, a) / (lc * la);
+    let an = a / la;
+    let bn = b / lb;
+    let cn = c / lc;
+    let sab = an + bn;
+    let sbc = bn + cn;
+    let sca = cn + an;
+    var den = 0.5 * dot(sab, sab) + dot(cn, sab);
+    if (dot(sbc, sbc) < dot(sab, sab) && dot(sbc, sbc) <= dot(sca, sca)) {
+        den = 0.5 * dot(sbc, sbc) + dot(an, sbc);
+    } else if (dot(sca, sca) < dot(sab, sab)) {
+        den = 0.5 * dot(sca, sca) + dot(bn, sca);
+    }
     return 2.0 * atan2_accurate(abs(det), den);
 }
 
@@ -138,7 +151,9 @@ fn spherical_triangle_solid_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f
 /// formula instead of Arvo's spherical trigonometry: for ĉ′ = cosφ·â + sinφ·ŵ (ŵ ⊥ â in the plane of â, ĉ),
 ///   tan(Ω′/2)·[(1 + â·b̂)(1 + cosφ) + sinφ (b̂·ŵ)] = sinφ |[â, b̂, ŵ]|
 /// ⇒ φ/2 = atan2((1 + â·b̂)·sin(Ω′/2), |[â, b̂, ŵ]|·cos(Ω′/2) − (b̂·ŵ)·sin(Ω′/2)),
-/// which has no cancellation for small triangles (Arvo's and pbrt-v4's forms lose digits there).
+/// which has no cancellation for small triangles (Arvo's and pbrt-v4's forms lose digits there). Step 2 works
+/// from ĉ′ − b̂ or from ĉ′ + b̂, whichever is shorter, so arcs that end nearly opposite b̂ (viewpoints near the
+/// triangle's plane) keep their precision too.
 fn square_to_spherical_triangle(u: vec2<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
     let la = length(a);
     let lb = length(b);
@@ -151,17 +166,22 @@ fn square_to_spherical_triangle(u: vec2<f32>, a: vec3<f32>, b: vec3<f32>, c: vec
     let w = normalize(cross(cross(a, e2), a));
     let d = abs(dot(cross(a, e1), w)) / (la * lb);     // |[â, b̂, ŵ]|
     let e = dot(e1, w) / lb;                          // b̂·ŵ (a·ŵ = 0)
-    let k = 1.0 + dot(an, bn);
+    let k = 0.5 * dot(an + bn, an + bn);             // 1 + â·b̂, exact also for nearly opposite â, b̂
     let half = 0.5 * u.x * omega;
     let sh = sin(half);
     let half_phi = atan2_accurate(k * sh, d * cos(half) - e * sh);
     let s_half = sin(half_phi);
-    // ĉ′ − b̂ = (â − b̂) + (cosφ − 1)·â + sinφ·ŵ, with cosφ − 1 = −2 sin²(φ/2).
-    let delta = (an - bn) - (2.0 * s_half * s_half) * an + sin(2.0 * half_phi) * w;
-    // Step 2: cosθ uniform in [b̂·ĉ′, 1] along the arc from b̂; 1 − b̂·ĉ′ = |ĉ′ − b̂|²/2.
-    let omc = u.y * 0.5 * dot(delta, delta);
-    let sin_theta = safe_sqrt(omc * (2.0 - omc));
-    let perp = normalize(delta - dot(delta, bn) * bn);
+    // ĉ′ ∓ b̂ = (â ∓ b̂) + (cosφ − 1)·â + sinφ·ŵ, with cosφ − 1 = −2 sin²(φ/2).
+    let rest = sin(2.0 * half_phi) * w - (2.0 * s_half * s_half) * an;
+    let dm = (an - bn) + rest;                        // ĉ′ − b̂
+    let dp = (an + bn) + rest;                        // ĉ′ + b̂
+    // Step 2: 1 − cosθ uniform in [0, 1 − b̂·ĉ′], with 1 − b̂·ĉ′ = |ĉ′ − b̂|²/2 and 1 + b̂·ĉ′ = |ĉ′ + b̂|²/2.
+    let omc = u.y * 0.5 * dot(dm, dm);
+    let opc = 2.0 * (1.0 - u.y) + u.y * 0.5 * dot(dp, dp);     // 1 + cosθ = 2 − (1 − cosθ)
+    let sin_theta = sqrt(max(omc * opc, 0.0));
+    // The tangent at b̂ towards ĉ′: the part of ĉ′ ∓ b̂ perpendicular to b̂, from the shorter one.
+    let dd = select(dm, dp, dot(dp, dp) < dot(dm, dm));
+    let perp = normalize(dd - dot(dd, bn) * bn);
     return normalize((1.0 - omc) * bn + sin_theta * perp);
 }
 fn square_to_spherical_triangle_pdf(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
@@ -237,20 +257,12 @@ fn spherical_rect_setup(x0: f32, y0: f32, w: f32, hgt: f32, h: f32) -> Spherical
     r.beta_diff = atan2_accurate(h * lb, h * h + r.b0 * r.b1);
     r.psi0 = spherical_rect_psi(r.a0, r.b0, r.b1, h);
     r.psi1 = spherical_rect_psi(r.a1, r.b0, r.b1, h);
-    // Ω: two Van Oosterom–Strackee triangles; both triple products equal h·w·hgt exactly.
+    // Ω: two spherical triangles (their triple products are exact in these coordinates).
     let v00 = vec3<f32>(x0, y0, -h);
     let v10 = vec3<f32>(x0 + w, y0, -h);
     let v11 = vec3<f32>(x0 + w, y0 + hgt, -h);
     let v01 = vec3<f32>(x0, y0 + hgt, -h);
-    let l00 = length(v00);
-    let l10 = length(v10);
-    let l11 = length(v11);
-    let l01 = length(v01);
-    let vol = h * w * hgt;
-    let c0011 = dot(v00, v11) / (l00 * l11);
-    let t1 = atan2_accurate(vol / (l00 * l10 * l11), 1.0 + dot(v00, v10) / (l00 * l10) + dot(v10, v11) / (l10 * l11) + c0011);
-    let t2 = atan2_accurate(vol / (l00 * l11 * l01), 1.0 + c0011 + dot(v11, v01) / (l11 * l01) + dot(v01, v00) / (l01 * l00));
-    r.omega = 2.0 * (t1 + t2);
+    r.omega = spherical_triangle_solid_angle(v00, v10, v11) + spherical_triangle_solid_angle(v00, v11, v01);
     return r;
 }
 

@@ -356,6 +356,8 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             }
         );
         println!("BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes", data.bvh_nodes.len(), data.bvh_seconds * 1e3, data.bvh_sah, data.bvh_bytes());
+        let features = mislab::features::Features::of(&data);
+        println!("features (code paths compiled into its specialised pipelines): {}", features.describe());
     }
     Ok(0)
 }

@@ -131,7 +131,13 @@ impl Viewer {
                 self.pending = None;
             }
         }
+        self.engine.shared().ui_taken = frame.serial;
         self.frame = Some(frame);
+    }
+
+    /// Tells the engine how long the UI's frames take (eframe measures building + painting).
+    pub fn set_ui_cost(&self, seconds: f64) {
+        self.engine.shared().ui_cost_s = seconds;
     }
 
     fn send_display(&self) {
@@ -226,13 +232,10 @@ impl Viewer {
         ui.separator();
 
         let sides = if self.compare { 2 } else { 1 };
-        for i in 0..sides {
-            let title = if self.compare { if i == 0 { "Estimator A" } else { "Estimator B" } } else { "Estimator" };
-            let mut changed = false;
-            egui::CollapsingHeader::new(title).id_salt(("estimator", i)).default_open(true).show(ui, |ui| {
-                changed = settings_ui(ui, &mut self.settings[i], i);
-            });
-            if changed {
+        ui.strong(if self.compare { "Estimators A | B" } else { "Estimator" });
+        let changed = settings_grid(ui, &mut self.settings, sides);
+        for (i, c) in changed.into_iter().enumerate() {
+            if c {
                 self.apply_settings(i);
             }
         }
@@ -259,37 +262,40 @@ impl Viewer {
         }
         ui.separator();
 
-        ui.strong("Compare");
-        let mut compare = self.compare;
-        if ui.checkbox(&mut compare, "compare A | B").changed() {
-            self.compare = compare;
-            if compare {
+        ui.horizontal(|ui| {
+            let mut compare = self.compare;
+            if ui.checkbox(&mut compare, "compare A | B").changed() {
+                self.compare = compare;
+                if compare {
+                    self.apply_settings(1);
+                }
+                self.engine.send(Command::Compare(compare));
+            }
+            if self.compare && ui.button("copy A to B").clicked() {
+                self.settings[1] = self.settings[0].clone();
                 self.apply_settings(1);
             }
-            self.engine.send(Command::Compare(compare));
-        }
-        if self.compare && ui.button("copy A to B").clicked() {
-            self.settings[1] = self.settings[0].clone();
-            self.apply_settings(1);
-        }
+        });
         ui.separator();
 
-        ui.strong("Statistics");
         let stats = self.engine.shared().stats.clone();
         stats_grid(ui, &stats[..sides], self.engine.shared().has_reference);
         ui.separator();
 
-        ui.strong("Camera");
-        ui.small("drag: orbit · right/middle drag: pan · wheel: zoom");
-        if ui.button("reset camera").clicked() {
-            let home = self.engine.shared().home_camera.clone();
-            self.orbit = None;
-            self.engine.send(Command::Camera(home));
-        }
+        ui.horizontal(|ui| {
+            if ui.button("reset camera").clicked() {
+                let home = self.engine.shared().home_camera.clone();
+                self.orbit = None;
+                self.engine.send(Command::Camera(home));
+            }
+            ui.small("drag: orbit · right drag: pan · wheel: zoom");
+        });
         ui.separator();
+        egui::CollapsingHeader::new("Files").default_open(false).show(ui, |ui| self.files_ui(ui));
+    }
 
-        ui.strong("Files");
-        ui.small("drop a .gltf/.glb/.toml scene, an .hdr/.exr environment or a reference .exr on the window");
+    fn files_ui(&mut self, ui: &mut egui::Ui) {
+        ui.small("or drop a .gltf/.glb/.toml scene, an .hdr/.exr environment or a reference .exr on the window");
         if path_row(ui, "scene path", &mut self.scene_path, "open scene") {
             let p = self.scene_path.clone();
             self.orbit = None;
@@ -436,22 +442,64 @@ fn choice<T: Copy + PartialEq>(ui: &mut egui::Ui, id: String, label: &str, v: &m
     changed
 }
 
-/// Every estimator setting, under its command-line name; returns whether any changed.
-pub fn settings_ui(ui: &mut egui::Ui, s: &mut Settings, side: usize) -> bool {
-    let mut c = false;
-    c |= choice(ui, format!("{side}-mode"), "mode", &mut s.mode, Mode::ALL, |v| v.name());
-    c |= choice(ui, format!("{side}-strategy"), "strategy", &mut s.strategy, Strategy::ALL, |v| v.name());
-    c |= choice(ui, format!("{side}-light-sampling"), "light-sampling", &mut s.light_sampling, LightSampling::ALL, |v| v.name());
-    c |= choice(ui, format!("{side}-env-sampling"), "env-sampling", &mut s.env_sampling, EnvSampling::ALL, |v| v.name());
-    c |= choice(ui, format!("{side}-light-select"), "light-select", &mut s.light_select, LightSelect::ALL, |v| v.name());
-    c |= choice(ui, format!("{side}-heuristic"), "heuristic", &mut s.heuristic, Heuristic::ALL, |v| v.name());
-    labelled(ui, "power-beta", |ui| ui.add(egui::DragValue::new(&mut s.power_beta).range(0.1..=16.0).speed(0.05)), &mut c);
-    c |= choice(ui, format!("{side}-mis"), "mis", &mut s.mis, MisKind::ALL, |v| v.name());
-    labelled(ui, "light-samples", |ui| ui.add(egui::DragValue::new(&mut s.light_samples).range(0..=64)), &mut c);
-    labelled(ui, "bsdf-samples", |ui| ui.add(egui::DragValue::new(&mut s.bsdf_samples).range(0..=64)), &mut c);
-    c |= choice(ui, format!("{side}-sampler"), "sampler", &mut s.sampler, SamplerKind::ALL, |v| v.name());
-    labelled(ui, "max-depth", |ui| ui.add(egui::DragValue::new(&mut s.max_depth).range(1..=256)), &mut c);
-    labelled(ui, "seed", |ui| ui.add(egui::DragValue::new(&mut s.seed)), &mut c);
+/// A combo box without a label of its own, named by `label` (the row's label in a grid).
+fn grid_choice<T: Copy + PartialEq>(ui: &mut egui::Ui, id: String, label: egui::Id, v: &mut T, all: &[T], name: impl Fn(&T) -> &'static str) -> bool {
+    let mut changed = false;
+    let r = egui::ComboBox::from_id_salt(id).selected_text(name(v)).width(112.0).show_ui(ui, |ui| {
+        for x in all {
+            if ui.selectable_value(v, *x, name(x)).changed() {
+                changed = true;
+            }
+        }
+    });
+    r.response.labelled_by(label);
+    changed
+}
+
+/// Every estimator setting of one or two sides, one row per setting named as on the command line,
+/// one column per side; returns which sides changed.
+pub fn settings_grid(ui: &mut egui::Ui, settings: &mut [Settings; 2], sides: usize) -> [bool; 2] {
+    let mut c = [false; 2];
+    egui::Grid::new("mislab-estimators").num_columns(1 + sides).spacing([6.0, 3.0]).show(ui, |ui| {
+        if sides == 2 {
+            ui.label("");
+            ui.strong("A");
+            ui.strong("B");
+            ui.end_row();
+        }
+        macro_rules! combo_row {
+            ($name:literal, $field:ident, $ty:ty) => {{
+                let l = ui.label($name).id;
+                for i in 0..sides {
+                    c[i] |= grid_choice(ui, format!("{i}-{}", $name), l, &mut settings[i].$field, <$ty>::ALL, |v| v.name());
+                }
+                ui.end_row();
+            }};
+        }
+        macro_rules! drag_row {
+            ($name:literal, $field:ident, $drag:expr) => {{
+                let l = ui.label($name).id;
+                for i in 0..sides {
+                    let r = ui.add($drag(&mut settings[i].$field)).labelled_by(l);
+                    c[i] |= r.changed();
+                }
+                ui.end_row();
+            }};
+        }
+        combo_row!("mode", mode, Mode);
+        combo_row!("strategy", strategy, Strategy);
+        combo_row!("light-sampling", light_sampling, LightSampling);
+        combo_row!("env-sampling", env_sampling, EnvSampling);
+        combo_row!("light-select", light_select, LightSelect);
+        combo_row!("heuristic", heuristic, Heuristic);
+        drag_row!("power-beta", power_beta, |v| egui::DragValue::new(v).range(0.1..=16.0).speed(0.05));
+        combo_row!("mis", mis, MisKind);
+        drag_row!("light-samples", light_samples, |v| egui::DragValue::new(v).range(0..=64));
+        drag_row!("bsdf-samples", bsdf_samples, |v| egui::DragValue::new(v).range(0..=64));
+        combo_row!("sampler", sampler, SamplerKind);
+        drag_row!("max-depth", max_depth, |v| egui::DragValue::new(v).range(1..=256));
+        drag_row!("seed", seed, |v| egui::DragValue::new(v));
+    });
     c
 }
 
@@ -478,11 +526,12 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
 /// The statistics of one or two sides as a grid.
 fn stats_grid(ui: &mut egui::Ui, stats: &[SideStats], has_reference: bool) {
     egui::Grid::new("mislab-stats").num_columns(stats.len() + 1).striped(true).show(ui, |ui| {
-        ui.label("");
-        for (i, _) in stats.iter().enumerate() {
-            ui.strong(if stats.len() == 1 { "" } else if i == 0 { "A" } else { "B" });
+        if stats.len() == 2 {
+            ui.label("");
+            ui.strong("A");
+            ui.strong("B");
+            ui.end_row();
         }
-        ui.end_row();
         let row = |ui: &mut egui::Ui, name: &str, f: &dyn Fn(&SideStats) -> String| {
             ui.label(name);
             for s in stats {

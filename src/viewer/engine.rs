@@ -27,9 +27,11 @@ use std::time::{Duration, Instant};
 pub const PREVIEW_SCALE: u32 = 8;
 /// GPU time one engine frame aims at, all sides together. It bounds how long a new command waits for
 /// the dispatch in flight, and leaves the CPU (lavapipe = the CPU) to the window between frames.
-pub const FRAME_BUDGET_S: f64 = 0.045;
+pub const FRAME_BUDGET_S: f64 = 0.035;
 /// Sample counts stop growing here (the image has long converged; the CPU goes back to idle).
 pub const MAX_SPP: u32 = 1 << 16;
+/// Longest the engine waits for the UI to take a frame (a hidden window takes none).
+pub const UI_WAIT: Duration = Duration::from_millis(150);
 
 /// One side of a comparison.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -187,6 +189,11 @@ pub struct Shared {
     pub display_ms: f64,
     /// Pipelines being compiled, for the status line.
     pub compiling: usize,
+    /// The serial of the last frame the UI took.
+    pub ui_taken: u64,
+    /// Seconds the UI's last frame took (building + painting): the engine leaves the CPU to the UI
+    /// this long after each frame.
+    pub ui_cost_s: f64,
 }
 
 /// The UI's handle on the engine thread.
@@ -868,9 +875,53 @@ impl Engine {
             let result = self.frame();
             let error = self.gpu_error.lock().unwrap_or_else(|p| p.into_inner()).take();
             match (result, error) {
-                (Ok(did), None) => idle = !did,
+                (Ok(did), None) => {
+                    idle = !did;
+                    if did {
+                        if let Some(c) = self.yield_to_ui(&rx) {
+                            match self.handle(c) {
+                                Ok(true) => {}
+                                Ok(false) => {
+                                    self.worker_stop.store(true, Ordering::SeqCst);
+                                    return;
+                                }
+                                Err(e) => self.message(e),
+                            }
+                        }
+                    }
+                }
                 (Err(e), _) => self.recover(e.to_string()),
                 (Ok(_), Some(e)) => self.recover(e),
+            }
+        }
+    }
+
+    /// Lavapipe renders the window on the same two cores: after posting a frame, wait until the UI has
+    /// taken it and had time to paint (at most `UI_WAIT`), so the window keeps its frame rate. A command
+    /// ends the wait at once (it is returned, to be handled before the next dispatch).
+    fn yield_to_ui(&self, rx: &Receiver<Command>) -> Option<Command> {
+        let start = Instant::now();
+        let mut taken_at: Option<Instant> = None;
+        loop {
+            let (taken, cost) = {
+                let s = self.shared();
+                (s.ui_taken >= self.frames, s.ui_cost_s)
+            };
+            if taken && taken_at.is_none() {
+                taken_at = Some(Instant::now());
+            }
+            if let Some(t) = taken_at {
+                if t.elapsed().as_secs_f64() >= cost.clamp(0.0, 0.03) {
+                    return None;
+                }
+            }
+            if start.elapsed() > UI_WAIT {
+                return None;
+            }
+            match rx.recv_timeout(Duration::from_millis(2)) {
+                Ok(c) => return Some(c),
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => return Some(Command::Quit),
             }
         }
     }

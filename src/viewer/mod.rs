@@ -290,7 +290,10 @@ impl App {
 }
 
 impl eframe::App for App {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        if let Some(cpu) = frame.info().cpu_usage {
+            self.viewer.set_ui_cost(cpu as f64);
+        }
         self.viewer.ui(ui);
         let ctx = ui.ctx().clone();
         self.screenshot_step(&ctx);
