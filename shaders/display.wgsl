@@ -1,6 +1,6 @@
 // display.wgsl — the viewer's display pass: per-pixel accumulators → what is shown (tonemapped image,
 // standard error, relMSE against a reference, NaN/Inf mask; error views in false colour) as packed
-// sRGB8, plus per-workgroup sums of the statistics the panel prints. Twin: src/viewer/display.rs.
+// sRGB8, plus per-column sums of the statistics the panel prints. Twin: src/viewer/display.rs.
 
 /// Same layout as `Accum` in common.wgsl (tests/viewer.rs checks both against `GpuAccum`).
 struct Accum {
@@ -14,7 +14,7 @@ struct Accum {
 struct DisplayParams {
     width: u32,
     height: u32,
-    /// VIEW_* tag.
+    /// VIEW_* tag (informative: the pipeline's `VIEW` constant decides).
     view: u32,
     /// TONEMAP_* tag.
     tonemap: u32,
@@ -33,12 +33,13 @@ struct DisplayParams {
     /// log10 of the values at the bottom and top of the false-colour scale.
     log_min: f32,
     log_max: f32,
+    /// Film rows this dispatch redraws (the rows the renderer changed; all of them after a restart).
+    row_offset: u32,
+    row_count: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
-/// Sums over one workgroup's pixels for one side (Rust twin: `SideSums`).
+/// Sums over one column's pixels for one side (Rust twin: `SideSums`).
 struct SideSums {
     /// Σ relative standard error (standard error of the mean / mean) over pixels with ≥ 2 samples and mean > 0.
     rel_se: f32,
@@ -60,6 +61,10 @@ struct Partial {
     b: SideSums,
 }
 
+/// The view (a VIEW_* tag) is a pipeline constant: lavapipe runs every case of a switch under masks,
+/// so a run-time choice would pay for all four views at every pixel.
+override VIEW: u32 = 0u;
+
 const VIEW_IMAGE: u32 = 0u;
 const VIEW_STDERR: u32 = 1u;
 const VIEW_RELMSE: u32 = 2u;
@@ -79,8 +84,6 @@ const REL_MSE_EPSILON: f32 = 0.01;
 @group(0) @binding(5) var<storage, read> reference: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> out_rgba: array<u32>;
 @group(0) @binding(7) var<storage, read_write> partials: array<Partial>;
-
-var<workgroup> wg_sums: array<Partial, 64>;
 
 fn display_is_nonfinite(x: f32) -> bool { return (bitcast<u32>(x) & 0x7f800000u) == 0x7f800000u; }
 
@@ -142,7 +145,7 @@ fn shown(full: Accum, px: vec2<u32>, side_b: bool) -> Accum {
 fn colour_of(a: Accum, ref_value: vec4<f32>, ref_ok: bool) -> vec3<f32> {
     let has = a.count + a.nonfinite > 0u;
     let no_data = vec3<f32>(0.18);
-    switch dp.view {
+    switch VIEW {
         case VIEW_STDERR: {
             let se = standard_error(a);
             if (se < 0.0) { return no_data; }
@@ -199,43 +202,47 @@ fn add_sums(x: SideSums, y: SideSums) -> SideSums {
     return s;
 }
 
+/// One pixel of the shown image. No statistics here: a workgroup reduction needs barriers, which
+/// lavapipe runs as coroutines (it made this pass ~30× slower); `stats_main` sums columns instead.
 @compute @workgroup_size(8, 8, 1)
-fn display_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32,
-                @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    var p: Partial;
-    // No early return: every invocation must reach the barrier below.
-    if (gid.x < dp.width && gid.y < dp.height) {
-        let i = gid.y * dp.width + gid.x;
+fn display_main(@builtin(global_invocation_id) gid3: vec3<u32>) {
+    let gid = vec2<u32>(gid3.x, gid3.y + dp.row_offset);
+    if (gid.x >= dp.width || gid3.y >= dp.row_count || gid.y >= dp.height) { return; }
+    let i = gid.y * dp.width + gid.x;
+    var ref_value = vec4<f32>(0.0);
+    var ref_ok = false;
+    if (dp.has_reference != 0u) {
+        ref_value = reference[i];
+        ref_ok = !(display_is_nonfinite(ref_value.x) || display_is_nonfinite(ref_value.y) || display_is_nonfinite(ref_value.z));
+    }
+    var colour: vec3<f32>;
+    if (dp.compare != 0u && gid.x >= dp.split_x) {
+        colour = colour_of(shown(accum_b[i], gid.xy, true), ref_value, ref_ok);
+    } else {
+        colour = colour_of(shown(accum_a[i], gid.xy, false), ref_value, ref_ok);
+    }
+    out_rgba[i] = pack4x8unorm(vec4<f32>(colour, 1.0));
+}
+
+/// The statistics sums of one film column (one invocation per column, so neighbouring invocations
+/// read neighbouring pixels), for both sides.
+@compute @workgroup_size(64, 1, 1)
+fn stats_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let x = gid.x;
+    if (x >= dp.width) { return; }
+    var total: Partial;
+    for (var y = 0u; y < dp.height; y += 1u) {
+        let i = y * dp.width + x;
         var ref_value = vec4<f32>(0.0);
         var ref_ok = false;
         if (dp.has_reference != 0u) {
             ref_value = reference[i];
             ref_ok = !(display_is_nonfinite(ref_value.x) || display_is_nonfinite(ref_value.y) || display_is_nonfinite(ref_value.z));
         }
-        let fa = accum_a[i];
-        p.a = side_sums(fa, ref_value, ref_ok);
-        var colour: vec3<f32>;
+        total.a = add_sums(total.a, side_sums(accum_a[i], ref_value, ref_ok));
         if (dp.compare != 0u) {
-            let fb = accum_b[i];
-            p.b = side_sums(fb, ref_value, ref_ok);
-            if (gid.x >= dp.split_x) {
-                colour = colour_of(shown(fb, gid.xy, true), ref_value, ref_ok);
-            } else {
-                colour = colour_of(shown(fa, gid.xy, false), ref_value, ref_ok);
-            }
-        } else {
-            colour = colour_of(shown(fa, gid.xy, false), ref_value, ref_ok);
+            total.b = add_sums(total.b, side_sums(accum_b[i], ref_value, ref_ok));
         }
-        out_rgba[i] = pack4x8unorm(vec4<f32>(colour, 1.0));
     }
-    wg_sums[lid] = p;
-    workgroupBarrier();
-    if (lid == 0u) {
-        var total: Partial;
-        for (var k = 0u; k < 64u; k += 1u) {
-            total.a = add_sums(total.a, wg_sums[k].a);
-            total.b = add_sums(total.b, wg_sums[k].b);
-        }
-        partials[wid.y * nwg.x + wid.x] = total;
-    }
+    partials[x] = total;
 }

@@ -147,16 +147,21 @@ fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
 // ---- triangle and quad lights by solid angle (spherical triangle / spherical rectangle) ----
 //
 // Fallback to area sampling, a deterministic function of (light, shading point) shared by sample_li and pdf_li:
-// the spherical warps are used only where their f32 error is small, measured against an f64 reference on this
-// device (tests/sampling.rs, `spherical_warps_precision`; table in docs/sampling.md). Below the minimum solid
-// angle the polygon is small and area sampling is nearly as good (its pdf is nearly constant over the light).
+// the spherical warps are used only where their f32 error on this platform stays below 1e-4 — sample positions
+// in units of the light's size and Ω relative, against f64 twins, over far / close (above the centre, an edge, a
+// vertex) / grazing viewpoints of regular and 100:1 sliver shapes (tests/sampling.rs `spherical_warps_precision`;
+// the table is in docs/sampling.md). Measured: triangles break down below ~6e-6 sr (slivers; regular ones hold to
+// ~1e-7 sr) and above ~5.8 sr (a viewpoint within ~1/1000 of the light's size of its plane, near an edge);
+// rectangles below ~2e-5 sr (slivers) and above ~5.8 sr (near a corner). Below the minimum the light is small and
+// area sampling is nearly as good (its pdf is nearly constant over the light); above the maximum the viewpoint
+// almost touches the light.
 
 /// Spherical-triangle sampling is used for triangles subtending [SPHERICAL_TRIANGLE_MIN_SR, SPHERICAL_TRIANGLE_MAX_SR].
 const SPHERICAL_TRIANGLE_MIN_SR: f32 = 1e-5;
-const SPHERICAL_TRIANGLE_MAX_SR: f32 = 6.2;
+const SPHERICAL_TRIANGLE_MAX_SR: f32 = 5.5;
 /// Spherical-rectangle sampling is used for rectangles subtending [SPHERICAL_RECT_MIN_SR, SPHERICAL_RECT_MAX_SR].
-const SPHERICAL_RECT_MIN_SR: f32 = 1e-5;
-const SPHERICAL_RECT_MAX_SR: f32 = 6.2;
+const SPHERICAL_RECT_MIN_SR: f32 = 5e-5;
+const SPHERICAL_RECT_MAX_SR: f32 = 5.5;
 /// A quad is a rectangle when |cos| of the angle between its edges is at most this; other parallelograms are
 /// sampled by area in either mode.
 const RECT_COS_TOLERANCE: f32 = 1e-5;

@@ -34,9 +34,10 @@ fn square_to_uniform_disk_concentric(u: vec2<f32>) -> vec2<f32> {
     return r * vec2<f32>(cos(theta), sin(theta));
 }
 
-/// Uniform on the upper hemisphere (z ≥ 0). Measure: solid angle, pdf 1/2π.
+/// Uniform on the upper hemisphere (z > 0). Measure: solid angle, pdf 1/2π. z = 1 − u.x ∈ (0, 1], so no sample
+/// lies on the horizon, where the pdf below is 0.
 fn square_to_uniform_hemisphere(u: vec2<f32>) -> vec3<f32> {
-    let z = u.x;
+    let z = 1.0 - u.x;
     let r = safe_sqrt(1.0 - z * z);
     let phi = TWO_PI * u.y;
     return vec3<f32>(r * cos(phi), r * sin(phi), z);
@@ -154,7 +155,23 @@ fn spherical_triangle_solid_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f
 /// which has no cancellation for small triangles (Arvo's and pbrt-v4's forms lose digits there). Step 2 works
 /// from ĉ′ − b̂ or from ĉ′ + b̂, whichever is shorter, so arcs that end nearly opposite b̂ (viewpoints near the
 /// triangle's plane) keep their precision too.
-fn square_to_spherical_triangle(u: vec2<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+fn square_to_spherical_triangle(u: vec2<f32>, va: vec3<f32>, vb: vec3<f32>, vc: vec3<f32>) -> vec3<f32> {
+    // Any labelling samples the same density. Take as the base a–c (the arc ĉ′ runs along) the shortest side:
+    // a base of nearly 180° (a viewpoint near a vertex or an edge, close to the triangle's plane) would put ĉ′
+    // where it moves fastest with φ.
+    let cab = dot(va, vb) / (length(va) * length(vb));
+    let cbc = dot(vb, vc) / (length(vb) * length(vc));
+    let cca = dot(vc, va) / (length(vc) * length(va));
+    var a = va;
+    var b = vb;
+    var c = vc;
+    if (cab > cca && cab >= cbc) {
+        b = vc;
+        c = vb;
+    } else if (cbc > cca) {
+        a = vb;
+        b = va;
+    }
     let la = length(a);
     let lb = length(b);
     let e1 = b - a;
@@ -224,17 +241,15 @@ fn spherical_rect_psi(a: f32, b0: f32, b1: f32, h: f32) -> f32 {
 }
 
 /// Prepares the rectangle [x0, x0 + w] × [y0, y0 + hgt] at depth h > 0 (the caller checks the side). The first
-/// axis is the one whose range lies nearer the foot of the perpendicular (x = y = 0): with the other axis's range
-/// straddling the foot and the first far from it (a rectangle seen edge-on from beside it), ψ(a0) and ψ(a1) would
-/// both be near ±π and Ω their small difference.
+/// axis is the one whose range reaches less far from the foot of the perpendicular (x = y = 0): along an axis that
+/// reaches far (≫ h; a rectangle seen edge-on from beside it, or the long side of a sliver seen from close by),
+/// ψ(a0) and ψ(a1) approach the strip's limits ±Δ, where the inversion below has no digits left.
 fn spherical_rect_setup(x0: f32, y0: f32, w: f32, hgt: f32, h: f32) -> SphericalRect {
     var r: SphericalRect;
     r.x0 = x0;
     r.y0 = y0;
     r.h = h;
-    let dx = max(max(x0, -(x0 + w)), 0.0);
-    let dy = max(max(y0, -(y0 + hgt)), 0.0);
-    r.swap = dx > dy;
+    r.swap = max(abs(x0), abs(x0 + w)) > max(abs(y0), abs(y0 + hgt));
     var la = w;
     var lb = hgt;
     r.a0 = x0;

@@ -30,6 +30,12 @@ struct Cli {
 enum Command {
     /// Render a scene progressively to PNG (tonemapped) or EXR (linear radiance).
     Render(RenderArgs),
+    /// Render a high-quality reference (MIS, Sobol) to EXR; the header records spp and settings.
+    Reference(mislab::reference::ReferenceArgs),
+    /// Run time against error: configurations × spp ladder × seeds, CSV/JSON and plots.
+    Bench(mislab::bench::BenchArgs),
+    /// Open the interactive viewer: the image converges while a panel switches estimators live.
+    View(mislab::viewer::ViewArgs),
     /// Print the Vulkan adapters, the chosen one and its limits; with a scene, its statistics.
     Info {
         /// A scene file or built-in name.
@@ -185,6 +191,9 @@ fn main() -> ExitCode {
     let result = match cli.command.unwrap_or(Command::Render(RenderArgs::default())) {
         Command::Render(args) => render(args),
         Command::Info { scene } => info(scene),
+        Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
+        Command::Reference(args) => mislab::reference::run(&args).map(|_| 0).map_err(bad),
+        Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
     };
     match result {
         Ok(code) => ExitCode::from(code),

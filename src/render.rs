@@ -57,6 +57,8 @@ pub struct Renderer {
     pub camera: Camera,
     /// Samples per pixel accumulated since the last reset.
     pub samples: u32,
+    /// Target count of the fixed-count samplers (`FrameParams::sampler_spp`; see `samplers::check_spp`).
+    pub sampler_spp: u32,
     /// Non-finite samples since the last reset (device counter, summed on the host).
     pub nonfinite_total: u64,
     /// Rays traced since the last reset.
@@ -106,6 +108,7 @@ impl Renderer {
                 },
                 storage(1, false),
                 storage(2, false),
+                storage(3, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -149,6 +152,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let sampler_data = ctx.storage_buffer("sampler_data", crate::samplers::sampler_data(), wgpu::BufferUsages::empty());
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
             layout: &layout1,
@@ -156,6 +160,7 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: accum.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: counters.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: sampler_data.as_entire_binding() },
             ],
         });
         let d = &scene.data;
@@ -174,6 +179,7 @@ impl Renderer {
             settings,
             camera,
             samples: 0,
+            sampler_spp: crate::samplers::DEFAULT_SAMPLER_SPP,
             nonfinite_total: 0,
             rays_total: 0,
             env_light: d.env_light.unwrap_or(INVALID),
@@ -298,7 +304,7 @@ impl Renderer {
             env_constant: self.env_constant,
             env_width: self.env_size.0,
             env_height: self.env_size.1,
-            sampler_spp: 0,
+            sampler_spp: self.sampler_spp,
             row_offset: 0,
             row_count: s.height,
         }

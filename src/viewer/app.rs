@@ -53,6 +53,7 @@ pub struct Viewer {
     /// Wall-clock intervals between UI frames, seconds (the last few hundred).
     pub frame_intervals: VecDeque<f64>,
     last_ui_frame: Option<Instant>,
+    taken_serial: u64,
 }
 
 impl Viewer {
@@ -77,6 +78,7 @@ impl Viewer {
             toggle_latencies_ms: Vec::new(),
             frame_intervals: VecDeque::new(),
             last_ui_frame: None,
+            taken_serial: 0,
         }
     }
 
@@ -132,6 +134,9 @@ impl Viewer {
             }
         }
         self.engine.shared().ui_taken = frame.serial;
+        self.taken_serial = frame.serial;
+        // One more UI frame soon: its start tells the engine this one has been painted.
+        ctx.request_repaint();
         self.frame = Some(frame);
     }
 
@@ -159,6 +164,10 @@ impl Viewer {
             self.ui_frames.pop_front();
         }
         let ctx = ui.ctx().clone();
+        if self.taken_serial > 0 {
+            // Everything taken in earlier UI frames has been painted by now.
+            self.engine.shared().ui_painted = self.taken_serial;
+        }
         self.take_frame(&ctx);
         self.dropped_files(&ctx);
         egui::Panel::left("mislab-panel").default_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
@@ -168,7 +177,7 @@ impl Viewer {
         let fatal = self.engine.shared().fatal.clone();
         if let Some(f) = fatal {
             egui::Window::new("The renderer stopped").collapsible(false).resizable(false).show(&ctx, |ui| {
-                ui.label(f);
+                ui.label(plain(&f));
                 ui.label("Close the window to exit.");
             });
         }
@@ -221,10 +230,10 @@ impl Viewer {
         ui.small(format!("device: {device}"));
         ui.small(format!("UI {:.0} frames/s · {fps_line}{}", self.ui_fps(), if compiling > 0 { format!(" · compiling {compiling} pipeline(s)") } else { String::new() }));
         if let Some(ms) = self.toggle_latencies_ms.last() {
-            ui.small(format!("last toggle → first image: {ms:.0} ms"));
+            ui.small(format!("last toggle to first image: {ms:.0} ms"));
         }
         if let Some(m) = message {
-            ui.small(m);
+            ui.small(plain(&m));
         }
         if !self.status.is_empty() {
             ui.colored_label(Color32::from_rgb(230, 120, 60), self.status.clone());
@@ -348,7 +357,7 @@ impl Viewer {
             }
             None => {
                 painter.rect_filled(rect, 0.0, Color32::from_gray(20));
-                painter.text(rect.center(), egui::Align2::CENTER_CENTER, "compiling the render pipeline…", egui::FontId::proportional(16.0), Color32::GRAY);
+                painter.text(rect.center(), egui::Align2::CENTER_CENTER, "compiling the render pipeline...", egui::FontId::proportional(16.0), Color32::GRAY);
             }
         }
         let stats = self.engine.shared().stats.clone();
@@ -418,6 +427,18 @@ impl Viewer {
             self.engine.send(Command::Camera(c));
         }
     }
+}
+
+/// Messages can quote compiler output (naga draws boxes with U+2500..): keep what egui's default
+/// fonts can draw.
+fn plain(s: &str) -> String {
+    s.chars()
+        .map(|c| match c {
+            '\u{2500}'..='\u{257F}' => '-',
+            c if (c as u32) < 0x2000 || matches!(c, '\u{2013}' | '\u{2014}' | '\u{2026}' | '\u{2018}' | '\u{2019}' | '\u{201C}' | '\u{201D}') => c,
+            _ => '?',
+        })
+        .collect()
 }
 
 /// A label and a widget named by it (kittest and screen readers find the widget by the label).
@@ -562,7 +583,7 @@ fn stats_grid(ui: &mut egui::Ui, stats: &[SideStats], has_reference: bool) {
 fn legend(ui: &mut egui::Ui, view: View, range: [f32; 2]) {
     let title = match view {
         View::StdErr => "standard error of the pixel mean (log scale)",
-        _ => "relMSE = (x − ref)² / (ref² + 0.01) (log scale)",
+        _ => "relMSE = (x - ref)^2 / (ref^2 + 0.01) (log scale)",
     };
     ui.small(title);
     let (rect, _) = ui.allocate_exact_size(Vec2::new(ui.available_width().min(300.0), 16.0), Sense::hover());

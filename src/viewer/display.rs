@@ -88,12 +88,12 @@ pub struct DisplayParams {
     pub preview_height: u32,
     pub log_min: f32,
     pub log_max: f32,
+    pub row_offset: u32,
+    pub row_count: u32,
     pub _pad0: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
 }
 
-/// One workgroup's statistics sums for one side (WGSL `SideSums`).
+/// One column's statistics sums for one side (WGSL `SideSums`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SideSums {
@@ -107,7 +107,7 @@ pub struct SideSums {
     pub _pad0: f32,
 }
 
-/// Both sides' sums of one workgroup (WGSL `Partial`).
+/// Both sides' sums of one column (WGSL `Partial`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Partial {
@@ -131,7 +131,7 @@ pub struct ImageStats {
 }
 
 impl ImageStats {
-    /// Sums the workgroup partials (in f64, so the sum of 4096 partials loses nothing that matters).
+    /// Sums the per-column partials (in f64).
     pub fn from_partials(p: &[SideSums]) -> ImageStats {
         let mut s = [0f64; 7];
         for x in p {
@@ -177,7 +177,9 @@ pub struct DisplayInputs<'a> {
 pub struct DisplayPass {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    pipeline: wgpu::ComputePipeline,
+    /// One per view (`View::tag` order).
+    pipelines: Vec<wgpu::ComputePipeline>,
+    stats_pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     out: wgpu::Buffer,
@@ -191,10 +193,11 @@ pub struct DisplayPass {
 
 /// The result of a display dispatch, read back.
 pub struct DisplayOutput {
-    /// RGBA8 pixels, row-major from the top (sRGB-encoded; alpha 255).
+    /// RGBA8 pixels, row-major from the top (sRGB-encoded; alpha 255): this frame's rows and the
+    /// earlier frames' others.
     pub rgba: Vec<u8>,
-    /// Side A's and side B's statistics.
-    pub stats: [ImageStats; 2],
+    /// Side A's and side B's statistics (when they were summed).
+    pub stats: Option<[ImageStats; 2]>,
 }
 
 impl DisplayPass {
@@ -224,29 +227,38 @@ impl DisplayPass {
         });
         let pipeline_layout =
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("display"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
-        let pipeline = crate::shaders::compute_pipeline(&device, "display", &display_source(), "display_main", &[], Some(&pipeline_layout))?;
+        let pipelines = View::ALL
+            .iter()
+            .map(|v| crate::shaders::compute_pipeline(&device, "display", &display_source(), "display_main", &[("VIEW", v.tag() as f64)], Some(&pipeline_layout)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let stats_pipeline = crate::shaders::compute_pipeline(&device, "display stats", &display_source(), "stats_main", &[], Some(&pipeline_layout))?;
         let workgroups = (width.div_ceil(8), height.div_ceil(8));
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
         };
         let pixels = width as u64 * height as u64;
         let out = buffer("display out", pixels * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let partial_bytes = (workgroups.0 * workgroups.1) as u64 * std::mem::size_of::<Partial>() as u64;
+        let partial_bytes = width as u64 * std::mem::size_of::<Partial>() as u64;
         let partials = buffer("display partials", partial_bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
         let staging = buffer("display staging", pixels * 4 + partial_bytes, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         let params = buffer("display params", std::mem::size_of::<DisplayParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         let dummy_reference = buffer("no reference", 16, wgpu::BufferUsages::STORAGE);
-        Ok(DisplayPass { device, queue: ctx.queue.clone(), pipeline, layout, params, out, partials, staging, dummy_reference, width, height, workgroups })
+        Ok(DisplayPass { device, queue: ctx.queue.clone(), pipelines, stats_pipeline, layout, params, out, partials, staging, dummy_reference, width, height, workgroups })
     }
 
-    /// Records the display dispatch and the copies to the staging buffer. Submit, wait, then `read`.
+    /// Records the display dispatch for rows `params.row_offset ..+ params.row_count`, the statistics
+    /// sums when `stats`, and the copies of what changed to the staging buffer (which keeps the other
+    /// rows from earlier frames). Submit, wait, then `read`.
     pub fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
         params: &DisplayParams,
         inputs: &DisplayInputs<'_>,
+        stats: bool,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
+        let row_offset = params.row_offset.min(self.height);
+        let row_count = params.row_count.min(self.height - row_offset);
         self.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let reference = inputs.reference.unwrap_or(&self.dummy_reference);
         let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -265,17 +277,28 @@ impl DisplayPass {
         });
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("display"), timestamp_writes: timestamps });
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(&self.pipelines[(params.view as usize).min(self.pipelines.len() - 1)]);
             pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(self.workgroups.0, self.workgroups.1, 1);
+            if row_count > 0 {
+                pass.dispatch_workgroups(self.workgroups.0, row_count.div_ceil(8), 1);
+            }
+            if stats {
+                pass.set_pipeline(&self.stats_pipeline);
+                pass.dispatch_workgroups(self.width.div_ceil(64), 1, 1);
+            }
         }
         let image_bytes = self.width as u64 * self.height as u64 * 4;
-        enc.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, image_bytes);
-        enc.copy_buffer_to_buffer(&self.partials, 0, &self.staging, image_bytes, self.partials.size().min(self.staging.size() - image_bytes));
+        let row_bytes = self.width as u64 * 4;
+        if row_count > 0 {
+            enc.copy_buffer_to_buffer(&self.out, row_offset as u64 * row_bytes, &self.staging, row_offset as u64 * row_bytes, row_count as u64 * row_bytes);
+        }
+        if stats {
+            enc.copy_buffer_to_buffer(&self.partials, 0, &self.staging, image_bytes, self.partials.size().min(self.staging.size() - image_bytes));
+        }
     }
 
     /// Maps the staging buffer (after the submission that `encode` recorded into) and reads it.
-    pub fn read(&self, ctx: &GpuContext) -> Result<DisplayOutput, GpuError> {
+    pub fn read(&self, ctx: &GpuContext, stats: bool) -> Result<DisplayOutput, GpuError> {
         let (tx, rx) = std::sync::mpsc::channel();
         self.staging.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);
@@ -290,11 +313,11 @@ impl DisplayPass {
         let out = {
             let data = self.staging.get_mapped_range(..).map_err(|e| GpuError::Map(format!("{e:?}")))?;
             let rgba = data[..image_bytes].to_vec();
-            let n = (self.workgroups.0 * self.workgroups.1) as usize;
+            let n = self.width as usize;
             let partials: Vec<Partial> = bytemuck::pod_collect_to_vec(&data[image_bytes..image_bytes + n * std::mem::size_of::<Partial>()]);
             let a: Vec<SideSums> = partials.iter().map(|p| p.a).collect();
             let b: Vec<SideSums> = partials.iter().map(|p| p.b).collect();
-            DisplayOutput { rgba, stats: [ImageStats::from_partials(&a), ImageStats::from_partials(&b)] }
+            DisplayOutput { rgba, stats: stats.then(|| [ImageStats::from_partials(&a), ImageStats::from_partials(&b)]) }
         };
         self.staging.unmap();
         Ok(out)

@@ -14,7 +14,7 @@ use crate::gpu::{GpuContext, GpuError};
 use crate::gpu_scene::{GpuScene, SceneData};
 use crate::render::Renderer;
 use crate::scene::{self, Camera, Environment, LoadOptions, Scene};
-use crate::settings::Settings;
+use crate::settings::{Settings, Strategy};
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -27,9 +27,13 @@ use std::time::{Duration, Instant};
 pub const PREVIEW_SCALE: u32 = 8;
 /// GPU time one engine frame aims at, all sides together. It bounds how long a new command waits for
 /// the dispatch in flight, and leaves the CPU (lavapipe = the CPU) to the window between frames.
-pub const FRAME_BUDGET_S: f64 = 0.035;
+pub const FRAME_BUDGET_S: f64 = 0.030;
 /// Sample counts stop growing here (the image has long converged; the CPU goes back to idle).
 pub const MAX_SPP: u32 = 1 << 16;
+/// How often the statistics are summed over the whole film (they cost a pass over every pixel).
+pub const STATS_INTERVAL: Duration = Duration::from_millis(250);
+/// Extra pause after the UI has painted a frame, seconds (see `yield_to_ui`).
+pub const UI_GAP_S: f64 = 0.008;
 /// Longest the engine waits for the UI to take a frame (a hidden window takes none).
 pub const UI_WAIT: Duration = Duration::from_millis(150);
 
@@ -191,6 +195,8 @@ pub struct Shared {
     pub compiling: usize,
     /// The serial of the last frame the UI took.
     pub ui_taken: u64,
+    /// The serial of the last frame the UI has painted (it started a later UI frame since).
+    pub ui_painted: u64,
     /// Seconds the UI's last frame took (building + painting): the engine leaves the CPU to the UI
     /// this long after each frame.
     pub ui_cost_s: f64,
@@ -258,6 +264,8 @@ pub struct EngineConfig {
     pub display: DisplayOptions,
     /// Warm each pipeline on a second device before the render device uses it (see `compile_worker`).
     pub warm_device: bool,
+    /// Build the generic pipeline (used after a toggle until the specialised one is built).
+    pub generic: bool,
 }
 
 /// Starts the engine thread on `ctx` (the render device). `repaint` is called after every frame.
@@ -298,10 +306,23 @@ struct CompileJob {
     settings: Settings,
     /// Lower first.
     priority: u32,
+    /// Request order.
+    seq: u64,
 }
 
+/// The pipelines the engine still needs (the worker skips jobs that are no longer in it).
+type Wanted = Arc<Mutex<HashSet<PipelineKey>>>;
+
+/// The worker's answer for a job it skipped.
+const SKIPPED: &str = "skipped";
+
 const PRIORITY_NOW: u32 = 0;
-const PRIORITY_GENERIC: u32 = 1;
+const PRIORITY_SPECULATIVE: u32 = 1;
+const PRIORITY_GENERIC: u32 = 2;
+
+/// How long the first dispatch of a new pipeline may take: lavapipe compiles it then, which took up
+/// to ~40 s for the generic pipeline on an idle 2-core machine with a cold shader cache, minutes under load.
+const WARM_UP_TIMEOUT: Duration = Duration::from_secs(900);
 
 /// Builds pipelines for the render device. With `warm`, each pipeline is first built and dispatched
 /// (0 samples) on that second device: lavapipe compiles at the first dispatch and keeps the machine
@@ -314,6 +335,7 @@ fn compile_worker(
     jobs: Receiver<CompileJob>,
     done: Sender<(PipelineKey, Result<wgpu::ComputePipeline, String>, f64)>,
     stop: Arc<AtomicBool>,
+    wanted: Wanted,
 ) {
     let warm = warm.and_then(|c| {
         let gs = GpuScene::upload(&c, SceneData::build(&Scene::default())).ok()?;
@@ -336,8 +358,17 @@ fn compile_worker(
         if stop.load(Ordering::SeqCst) {
             return;
         }
-        queue.sort_by_key(|j| j.priority);
+        // Most urgent first; among equals the newest (the settings the user has now).
+        queue.sort_by_key(|j| (j.priority, std::cmp::Reverse(j.seq)));
         let job = queue.remove(0);
+        if !wanted.lock().unwrap_or_else(|p| p.into_inner()).contains(&job.key) {
+            // The settings moved on before this pipeline was started: skip it (the engine asks again
+            // if it needs it).
+            if done.send((job.key, Err(SKIPPED.into()), 0.0)).is_err() {
+                return;
+            }
+            continue;
+        }
         let t = Instant::now();
         if let Some((c, _, r)) = warm.as_mut() {
             r.features = job.key.features;
@@ -372,6 +403,8 @@ struct SideState {
     generation: u64,
     pipeline: PipelineState,
     last_gpu_ms: f64,
+    /// When the accumulation last restarted (logged with the time to its first image).
+    restarted_at: Option<Instant>,
 }
 
 impl SideState {
@@ -396,6 +429,7 @@ impl SideState {
             generation: 0,
             pipeline: PipelineState::Compiling,
             last_gpu_ms: 0.0,
+            restarted_at: None,
         })
     }
 
@@ -409,6 +443,7 @@ impl SideState {
         self.render_seconds = 0.0;
         self.pixel_samples = 0.0;
         self.generation += 1;
+        self.restarted_at = Some(Instant::now());
     }
 
     fn set_settings(&mut self, s: Settings) {
@@ -445,7 +480,7 @@ impl SideState {
 /// One dispatch of an engine frame.
 enum Dispatch {
     Preview,
-    Band { rows: u32, spp: u32 },
+    Band { row0: u32, rows: u32, spp: u32 },
 }
 
 struct Timestamps {
@@ -476,12 +511,23 @@ struct Engine {
     lost: Arc<AtomicBool>,
     gpu_error: Arc<Mutex<Option<String>>>,
     warm_device: bool,
+    generic: bool,
+    wanted: Wanted,
+    seq: u64,
+    /// The settings each requested pipeline was asked for (its warm-up dispatch needs them).
+    job_settings: HashMap<PipelineKey, Settings>,
+    /// An 8×8 renderer of an empty scene that runs each new pipeline's first (0-sample) dispatch.
+    warm: Renderer,
+    warm_scene: GpuScene,
     frames: u64,
     settings: [Settings; 2],
     camera: Camera,
     recoveries: u32,
     /// Display inputs of the last frame (a change redraws even when nothing renders).
     last_options: Option<(DisplayOptions, bool, bool)>,
+    /// When the statistics were last summed, and their values.
+    last_stats: Instant,
+    image_stats: [ImageStats; 2],
 }
 
 fn scene_centre(scene: &Scene) -> glam::Vec3 {
@@ -523,11 +569,13 @@ impl Engine {
             sides.push(SideState::new(&ctx, &gs, camera.clone(), Settings { width: w, height: h, ..s.clone() })?);
         }
         let display = DisplayPass::new(&ctx, w, h)?;
-        let (jobs, compiled, worker_stop) = Self::start_worker(&ctx, &sides[0].renderer, config.warm_device);
+        let wanted: Wanted = Arc::new(Mutex::new(HashSet::new()));
+        let (jobs, compiled, worker_stop) = Self::start_worker(&ctx, &sides[0].renderer, config.warm_device, wanted.clone());
         let lost = Arc::new(AtomicBool::new(false));
         let gpu_error = Arc::new(Mutex::new(None));
         Self::watch_device(&ctx, &lost, &gpu_error);
         let timestamps = Self::make_timestamps(&ctx);
+        let (warm_scene, warm) = Self::warm_renderer(&ctx)?;
         {
             let mut s = shared.lock().unwrap_or_else(|p| p.into_inner());
             s.scene = config.scene_name.clone();
@@ -557,11 +605,19 @@ impl Engine {
             lost,
             gpu_error,
             warm_device: config.warm_device,
+            generic: config.generic,
+            wanted,
+            seq: 0,
+            job_settings: HashMap::new(),
+            warm,
+            warm_scene,
             frames: 0,
             settings: config.settings,
             camera,
             recoveries: 0,
             last_options: None,
+            last_stats: Instant::now(),
+            image_stats: Default::default(),
         };
         e.request_pipelines();
         Ok(e)
@@ -571,6 +627,7 @@ impl Engine {
         ctx: &GpuContext,
         layout_of: &Renderer,
         warm_device: bool,
+        wanted: Wanted,
     ) -> (Sender<CompileJob>, Receiver<(PipelineKey, Result<wgpu::ComputePipeline, String>, f64)>, Arc<AtomicBool>) {
         let (jobs_tx, jobs_rx) = mpsc::channel();
         let (done_tx, done_rx) = mpsc::channel();
@@ -581,9 +638,15 @@ impl Engine {
         let stop2 = stop.clone();
         std::thread::Builder::new()
             .name("mislab-compile".into())
-            .spawn(move || compile_worker(device, layout, warm, jobs_rx, done_tx, stop2))
+            .spawn(move || compile_worker(device, layout, warm, jobs_rx, done_tx, stop2, wanted))
             .expect("spawning the pipeline compiler thread");
         (jobs_tx, done_rx, stop)
+    }
+
+    fn warm_renderer(ctx: &GpuContext) -> Result<(GpuScene, Renderer), String> {
+        let gs = GpuScene::upload(ctx, SceneData::build(&Scene::default()))?;
+        let r = Renderer::new_unprepared(ctx, &gs, Camera::default(), Settings { width: 8, height: 8, ..Settings::default() })?;
+        Ok((gs, r))
     }
 
     fn watch_device(ctx: &GpuContext, lost: &Arc<AtomicBool>, gpu_error: &Arc<Mutex<Option<String>>>) {
@@ -638,39 +701,109 @@ impl Engine {
     }
 
     fn request(&mut self, key: PipelineKey, settings: &Settings, priority: u32) {
+        self.update_wanted();
         if self.pipelines.contains_key(&key) || !self.requested.insert(key) {
             return;
         }
-        let _ = self.jobs.send(CompileJob { key, settings: settings.clone(), priority });
+        self.job_settings.insert(key, settings.clone());
+        self.seq += 1;
+        let _ = self.jobs.send(CompileJob { key, settings: settings.clone(), priority, seq: self.seq });
+    }
+
+    /// The keys the active sides need now, their every-strategy neighbours, and the generic one.
+    fn update_wanted(&self) {
+        let mut w = self.wanted.lock().unwrap_or_else(|p| p.into_inner());
+        w.clear();
+        for side in self.sides.iter().take(self.active()) {
+            for (key, _) in Self::neighbours(side) {
+                w.insert(key);
+            }
+        }
+        if self.generic {
+            w.insert(PipelineKey::generic());
+        }
+    }
+
+    /// The specialised pipelines a side needs now (first) and after a strategy toggle (the lecture's
+    /// main comparison): built ahead so that such a toggle shows its first image at once.
+    fn neighbours(side: &SideState) -> Vec<(PipelineKey, Settings)> {
+        let s = &side.renderer.settings;
+        let mut v = vec![(PipelineKey::specialized(side.renderer.features, s), s.clone())];
+        for st in Strategy::ALL {
+            let n = Settings { strategy: *st, ..s.clone() };
+            let k = PipelineKey::specialized(side.renderer.features, &n);
+            if !v.iter().any(|(x, _)| *x == k) {
+                v.push((k, n));
+            }
+        }
+        v
     }
 
     /// Asks for the specialised pipelines of the active sides first, then the generic one.
     fn request_pipelines(&mut self) {
         for i in 0..self.active() {
-            let key = PipelineKey::specialized(self.sides[i].renderer.features, &self.sides[i].renderer.settings);
-            let s = self.sides[i].renderer.settings.clone();
-            self.request(key, &s, PRIORITY_NOW);
+            for (n, (key, s)) in Self::neighbours(&self.sides[i]).into_iter().enumerate() {
+                self.request(key, &s, if n == 0 { PRIORITY_NOW } else { PRIORITY_SPECULATIVE });
+            }
         }
-        let s = self.sides[0].renderer.settings.clone();
-        self.request(PipelineKey::generic(), &s, PRIORITY_GENERIC);
+        if self.generic {
+            let s = self.sides[0].renderer.settings.clone();
+            self.request(PipelineKey::generic(), &s, PRIORITY_GENERIC);
+        }
     }
 
     fn collect_compiled(&mut self) {
         loop {
             match self.compiled.try_recv() {
                 Ok((key, Ok(p), secs)) => {
-                    log::info!("pipeline {} ready after {secs:.2} s", if key.fixed.is_some() { "specialised" } else { "generic" });
-                    self.pipelines.insert(key, p);
+                    let t = Instant::now();
+                    let warmed = self.warm_up(key, &p);
+                    log::info!(
+                        "pipeline {} built in {secs:.2} s (worker thread), first dispatch {:.2} s (render thread)",
+                        if key.fixed.is_some() { "specialised" } else { "generic" },
+                        t.elapsed().as_secs_f64()
+                    );
                     self.requested.remove(&key);
+                    match warmed {
+                        Ok(()) => {
+                            self.pipelines.insert(key, p);
+                        }
+                        Err(e) => *self.gpu_error.lock().unwrap_or_else(|p| p.into_inner()) = Some(e),
+                    }
                 }
                 Ok((key, Err(e), _)) => {
                     self.requested.remove(&key);
-                    self.shared().fatal = Some(format!("a render pipeline failed to build: {e}"));
+                    if e != SKIPPED {
+                        self.shared().fatal = Some(format!("a render pipeline failed to build: {e}"));
+                    }
                 }
                 Err(_) => break,
             }
         }
         self.shared().compiling = self.requested.len();
+    }
+
+    /// Runs a 0-sample dispatch of a new pipeline on the render device: lavapipe compiles the shader
+    /// at its first dispatch (seconds; tens of seconds for the generic pipeline on a cold cache), and
+    /// that must not count as a frame (nor time out like one).
+    fn warm_up(&mut self, key: PipelineKey, p: &wgpu::ComputePipeline) -> Result<(), String> {
+        let settings = self.job_settings.get(&key).cloned().unwrap_or_default();
+        let w = &mut self.warm;
+        w.features = key.features;
+        w.settings = Settings { width: 8, height: 8, ..settings };
+        w.specialize = key.fixed.is_some();
+        if w.key() != key {
+            return Ok(());
+        }
+        w.insert_pipeline(key, p.clone());
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        w.encode_rows(&mut enc, 0, 0, 8, None);
+        self.ctx.queue.submit([enc.finish()]);
+        self.ctx
+            .device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(WARM_UP_TIMEOUT) })
+            .map(|_| ())
+            .map_err(|e| format!("compiling a pipeline: {e}"))
     }
 
     /// Chooses the pipeline of side `i` (specialised if built, else generic if built) and hands it to
@@ -714,9 +847,7 @@ impl Engine {
                 if !same_estimator {
                     self.sides[i].set_settings(s);
                     if i < self.active() {
-                        let key = PipelineKey::specialized(self.sides[i].renderer.features, &self.sides[i].renderer.settings);
-                        let s = self.sides[i].renderer.settings.clone();
-                        self.request(key, &s, PRIORITY_NOW);
+                        self.request_pipelines();
                     }
                 }
             }
@@ -905,13 +1036,15 @@ impl Engine {
         loop {
             let (taken, cost) = {
                 let s = self.shared();
-                (s.ui_taken >= self.frames, s.ui_cost_s)
+                (s.ui_painted >= self.frames, s.ui_cost_s)
             };
             if taken && taken_at.is_none() {
                 taken_at = Some(Instant::now());
             }
             if let Some(t) = taken_at {
-                if t.elapsed().as_secs_f64() >= cost.clamp(0.0, 0.03) {
+                // The UI's GPU work (rasterising the window on the same CPU) may still run after it
+                // began its next frame: leave it a few milliseconds more.
+                if t.elapsed().as_secs_f64() >= UI_GAP_S + cost.clamp(0.0, 0.02) {
                     return None;
                 }
             }
@@ -947,10 +1080,13 @@ impl Engine {
             let (w, h) = (self.settings[0].width, self.settings[0].height);
             let display = DisplayPass::new(&ctx, w, h)?;
             self.worker_stop.store(true, Ordering::SeqCst);
-            let (jobs, compiled, stop) = Self::start_worker(&ctx, &sides[0].renderer, self.warm_device);
+            let (jobs, compiled, stop) = Self::start_worker(&ctx, &sides[0].renderer, self.warm_device, self.wanted.clone());
             let lost = Arc::new(AtomicBool::new(false));
             Self::watch_device(&ctx, &lost, &self.gpu_error);
             self.timestamps = Self::make_timestamps(&ctx);
+            let (warm_scene, warm) = Self::warm_renderer(&ctx)?;
+            self.warm_scene = warm_scene;
+            self.warm = warm;
             self.reference = None;
             self.ctx = ctx;
             self.gs = gs;
@@ -1014,14 +1150,14 @@ impl Engine {
                 }
                 let spp = side.pass_spp;
                 side.renderer.encode_rows(&mut enc, spp, side.pass_row, rows, ts);
-                dispatches.push((i, Dispatch::Band { rows, spp }));
+                dispatches.push((i, Dispatch::Band { row0: side.pass_row, rows, spp }));
             }
         }
         if dispatches.is_empty() && self.frames > 0 && !self.display_dirty() {
             return Ok(false);
         }
         if self.sides.iter().take(n).all(|s| s.pipeline == PipelineState::Compiling) {
-            self.publish_stats(None);
+            self.publish_stats();
             return Ok(false);
         }
         let (w, h) = (self.settings[0].width, self.settings[0].height);
@@ -1040,22 +1176,49 @@ impl Engine {
             preview_height: self.sides[0].preview.settings.height,
             log_min: self.options.log_range[0],
             log_max: self.options.log_range[1],
+            row_offset: 0,
+            row_count: h,
             ..Default::default()
         };
+        // Redraw only the rows rendered this frame, unless everything changed (a restart shows the
+        // preview everywhere; display options change every pixel).
+        let full = self.frames == 0 || self.display_dirty() || dispatches.iter().any(|(_, d)| matches!(d, Dispatch::Preview));
+        let params = if full {
+            params
+        } else {
+            let bands = dispatches.iter().filter_map(|(_, d)| match d {
+                Dispatch::Band { row0, rows, .. } => Some((*row0, row0 + rows)),
+                Dispatch::Preview => None,
+            });
+            let (lo, hi) = bands.fold((h, 0), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+            DisplayParams { row_offset: lo.min(hi), row_count: hi.saturating_sub(lo), ..params }
+        };
+        // Not in a restart's first frame: its full-resolution accumulators are empty, and the first
+        // image should come as fast as possible (the statistics follow in the next frame).
+        let preview_frame = dispatches.iter().any(|(_, d)| matches!(d, Dispatch::Preview));
+        for (i, d) in &dispatches {
+            if matches!(d, Dispatch::Preview) {
+                self.image_stats[*i] = ImageStats::default();
+            }
+        }
+        let stats = !preview_frame && (full || self.last_stats.elapsed() >= STATS_INTERVAL);
+        if stats {
+            self.last_stats = Instant::now();
+        }
         let ts = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites { query_set: &t.set, beginning_of_pass_write_index: Some(4), end_of_pass_write_index: Some(5) });
         let inputs = DisplayInputs {
             accum: [self.sides[0].renderer.accum_buffer(), self.sides[b].renderer.accum_buffer()],
             preview: [self.sides[0].preview.accum_buffer(), self.sides[b].preview.accum_buffer()],
             reference: self.reference.as_ref(),
         };
-        self.display.encode(&mut enc, &params, &inputs, ts);
+        self.display.encode(&mut enc, &params, &inputs, stats, ts);
         if let Some(t) = &self.timestamps {
             enc.resolve_query_set(&t.set, 0..6, &t.resolve, 0);
             enc.copy_buffer_to_buffer(&t.resolve, 0, &t.staging, 0, 48);
         }
         let t0 = Instant::now();
         self.ctx.queue.submit([enc.finish()]);
-        let out = self.display.read(&self.ctx)?;
+        let out = self.display.read(&self.ctx, stats)?;
         let wall = t0.elapsed().as_secs_f64();
         let stamps = match &self.timestamps {
             Some(t) => Some(read_timestamps(&self.ctx, t)?),
@@ -1080,8 +1243,18 @@ impl Engine {
                 Dispatch::Preview => {
                     side.preview.samples += 1;
                     side.preview_done = true;
+                    if let Some(t) = side.restarted_at.take() {
+                        log::info!(
+                            "side {i}: first image {:.0} ms after the restart (preview {:.1} GPU ms, display {:.1} GPU ms, submit to readback {:.1} ms, {:?} pipeline)",
+                            t.elapsed().as_secs_f64() * 1e3,
+                            secs * 1e3,
+                            stamps.map(|s| (s[5].saturating_sub(s[4]) as f64) * 1e-6).unwrap_or(0.0),
+                            wall * 1e3,
+                            side.pipeline
+                        );
+                    }
                 }
-                Dispatch::Band { rows, spp } => {
+                Dispatch::Band { rows, spp, .. } => {
                     side.render_seconds += secs;
                     side.pixel_samples += pixels;
                     side.pass_row += rows;
@@ -1114,7 +1287,10 @@ impl Engine {
             s.display_ms = display_ms;
         }
         self.last_options = Some((self.options, self.reference.is_some(), self.compare));
-        self.publish_stats(Some(out.stats));
+        if let Some(s) = out.stats {
+            self.image_stats = s;
+        }
+        self.publish_stats();
         Ok(true)
     }
 
@@ -1126,11 +1302,11 @@ impl Engine {
         let s = &self.sides[i];
         match d {
             Dispatch::Preview => (s.preview.settings.width * s.preview.settings.height) as f64,
-            Dispatch::Band { rows, spp } => (s.renderer.settings.width * rows * spp) as f64,
+            Dispatch::Band { rows, spp, .. } => (s.renderer.settings.width * rows * spp) as f64,
         }
     }
 
-    fn publish_stats(&mut self, image: Option<[ImageStats; 2]>) {
+    fn publish_stats(&mut self) {
         let n = self.active();
         let mut stats: [SideStats; 2] = Default::default();
         for i in 0..2 {
@@ -1144,7 +1320,7 @@ impl Engine {
                 samples_per_s: if side.render_seconds > 0.0 { side.pixel_samples / side.render_seconds } else { 0.0 },
                 mrays_per_s: if side.render_seconds > 0.0 { r.rays_total as f64 / side.render_seconds / 1e6 } else { 0.0 },
                 gpu_ms: side.last_gpu_ms,
-                image: image.map(|s| s[i]).unwrap_or_default(),
+                image: self.image_stats[i],
                 nonfinite_samples: r.nonfinite_total,
                 pipeline: if i < n { side.pipeline } else { PipelineState::Compiling },
                 shown: side.preview_done,

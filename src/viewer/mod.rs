@@ -70,9 +70,13 @@ pub struct ViewArgs {
     /// strategy, one toggle every 1.5 s) and print how long each took to show the new estimator.
     #[arg(long, default_value_t = 0)]
     pub toggles: u32,
-    /// Build pipelines without first warming them on a second device (see docs/viewer.md).
+    /// Experimental: compile each pipeline on a second device first, hoping Mesa's shader cache spares
+    /// the render device the compile (it did not in our measurements; see docs/viewer.md).
     #[arg(long, hide = true)]
-    pub no_warm_device: bool,
+    pub warm_device: bool,
+    /// Never build the generic pipeline (a toggle then waits for its specialised pipeline).
+    #[arg(long, hide = true)]
+    pub no_generic: bool,
 }
 
 fn parse_view(s: &str) -> Result<View, String> {
@@ -123,7 +127,8 @@ pub fn config(args: &ViewArgs, scene: Scene) -> Result<(EngineConfig, [Settings;
         settings: settings.clone(),
         compare: args.compare.is_some(),
         display,
-        warm_device: !args.no_warm_device,
+        warm_device: args.warm_device,
+        generic: !args.no_generic,
     };
     Ok((config, settings, display))
 }
@@ -163,6 +168,8 @@ type Outcome = Arc<Mutex<Option<Result<(), String>>>>;
 
 struct App {
     viewer: Viewer,
+    /// CPU seconds eframe measured for each UI frame (building + painting).
+    ui_cpu: Vec<f64>,
     shot: Option<Screenshot>,
     outcome: Outcome,
 }
@@ -261,6 +268,11 @@ impl App {
                 q(1.0)
             );
         }
+        if !self.ui_cpu.is_empty() {
+            let mut c = self.ui_cpu.clone();
+            c.sort_by(|a, b| a.total_cmp(b));
+            eprintln!("UI frame CPU time (eframe): median {:.1} ms, max {:.1} ms", c[c.len() / 2] * 1e3, c[c.len() - 1] * 1e3);
+        }
         let lat = &self.viewer.toggle_latencies_ms;
         if !lat.is_empty() {
             let mut s = lat.clone();
@@ -293,6 +305,7 @@ impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         if let Some(cpu) = frame.info().cpu_usage {
             self.viewer.set_ui_cost(cpu as f64);
+            self.ui_cpu.push(cpu as f64);
         }
         self.viewer.ui(ui);
         let ctx = ui.ctx().clone();
@@ -320,7 +333,12 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default().with_title(format!("mislab view — {}", args.scene)).with_inner_size([width, height]),
         renderer: eframe::Renderer::Wgpu,
-        wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup), ..Default::default() },
+        wgpu_options: egui_wgpu::WgpuConfiguration {
+            wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup),
+            // Without vsync: on a software rasterizer a frame should be shown as soon as it is drawn.
+            surface: egui_wgpu::SurfaceConfig { present_mode: wgpu::PresentMode::AutoNoVsync, desired_maximum_frame_latency: Some(1) },
+            ..Default::default()
+        },
         ..Default::default()
     };
     let outcome: Outcome = Arc::new(Mutex::new(None));
@@ -350,7 +368,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
                 saved: Arc::new(Mutex::new(None)),
                 rendering_since: None,
             });
-            Ok(Box::new(App { viewer, shot, outcome: outcome2 }))
+            Ok(Box::new(App { viewer, ui_cpu: Vec::new(), shot, outcome: outcome2 }))
         }),
     );
     if let Some(e) = startup_error.lock().unwrap_or_else(|p| p.into_inner()).take() {

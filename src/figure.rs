@@ -1,0 +1,254 @@
+//! The lecture's figures, reproduced by one command: `mislab figure veach|area-vs-cosine -o OUT.png` renders
+//! the panels at equal samples per pixel, side by side, each labelled (a built-in 5×7 bitmap font, no font files).
+//!
+//! - `veach`: Veach's plates (thesis fig. 9.2) under light sampling, BSDF sampling, and MIS with the balance
+//!   and the power heuristic — light sampling is noisy on the sharp plates under the large lights, BSDF
+//!   sampling on the rough plates under the small lights, MIS is good everywhere.
+//! - `area-vs-cosine`: the lecture's slides of a floor under a low area light — light sampling by area (noisy
+//!   near the light: the r⁻² term), cosine sampling (noisy far from it: the light's small solid angle), and MIS.
+//! - `samplers`: not yet — the sample-sequence figure comes with the sampler comparison.
+
+use crate::film::{Film, Tonemap};
+use crate::gpu::GpuContext;
+use crate::gpu_scene::{GpuScene, SceneData};
+use crate::render::Renderer;
+use crate::scene::{self, LoadOptions};
+use crate::settings::{Heuristic, LightSampling, Settings, Strategy};
+use std::path::PathBuf;
+
+/// `mislab figure WHICH -o OUT.png`: one of the lecture's figures as a labelled PNG.
+#[derive(clap::Args, Clone, Debug)]
+pub struct FigureArgs {
+    /// Which figure: veach (light / BSDF / balance / power on Veach's plates), area-vs-cosine (area / cosine / MIS)
+    /// or samplers (not yet available).
+    pub which: String,
+    /// Output PNG.
+    #[arg(short, long, default_value = "figure.png")]
+    pub output: PathBuf,
+    /// Samples per pixel of every panel (the same for all, as in the lecture).
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Width of one panel in pixels.
+    #[arg(long, default_value_t = 256)]
+    pub width: u32,
+    /// Height of one panel in pixels.
+    #[arg(long, default_value_t = 256)]
+    pub height: u32,
+    /// Seed of every random number (the same for every panel).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+}
+
+/// Names accepted by `FigureArgs::which`.
+pub const FIGURES: &[&str] = &["veach", "area-vs-cosine", "samplers"];
+
+/// Gap between panels, pixels.
+const GAP: u32 = 4;
+
+/// One panel: its label and settings.
+struct Panel {
+    label: &'static str,
+    settings: Settings,
+}
+
+/// The scene, the grid (columns) and the panels of a figure.
+fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>), String> {
+    let with = |strategy: Strategy| Settings { strategy, ..base.clone() };
+    match which {
+        "veach" => Ok((
+            "veach-mis",
+            2,
+            vec![
+                Panel { label: "light sampling", settings: with(Strategy::Light) },
+                Panel { label: "BSDF sampling", settings: with(Strategy::Bsdf) },
+                Panel { label: "MIS: balance heuristic", settings: Settings { heuristic: Heuristic::Balance, ..with(Strategy::Mis) } },
+                Panel { label: "MIS: power heuristic", settings: Settings { heuristic: Heuristic::Power, ..with(Strategy::Mis) } },
+            ],
+        )),
+        "area-vs-cosine" => Ok((
+            "area-vs-cosine",
+            3,
+            vec![
+                Panel { label: "area sampling", settings: Settings { light_sampling: LightSampling::Area, ..with(Strategy::Light) } },
+                Panel { label: "cosine sampling", settings: with(Strategy::Cosine) },
+                Panel { label: "MIS", settings: with(Strategy::Mis) },
+            ],
+        )),
+        "samplers" => Err("figure 'samplers': not yet available (it comes with the sample-sequence comparison)".into()),
+        other => Err(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", "))),
+    }
+}
+
+/// Renders the figure `args.which` and writes it to `args.output` (PNG).
+pub fn run(args: &FigureArgs) -> Result<(), String> {
+    let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    if ext.as_deref() != Some("png") {
+        return Err(format!("{}: figures are written as PNG (use a .png name)", args.output.display()));
+    }
+    if args.spp == 0 {
+        return Err("--spp must be at least 1".into());
+    }
+    let base = Settings { width: args.width, height: args.height, seed: args.seed, ..Settings::default() };
+    let (scene_name, columns, panels) = layout(&args.which, &base)?;
+    base.validate()?;
+    let ctx = GpuContext::new().map_err(|e| format!("no usable GPU adapter: {e}"))?;
+    let scene = scene::load(scene_name, &LoadOptions::default()).map_err(|e| e.to_string())?;
+    let gpu_scene = GpuScene::upload(&ctx, SceneData::build(&scene)).map_err(|e| format!("{scene_name}: {e}"))?;
+    let mut renderer = Renderer::new_unprepared(&ctx, &gpu_scene, scene.camera.clone(), base.clone())?;
+    let mut images = Vec::new();
+    for p in &panels {
+        renderer.set_settings(p.settings.clone())?;
+        let film = render(&ctx, &mut renderer, args.spp)?;
+        let mut img = film.to_rgb8(p.settings.exposure, Tonemap::Clamp);
+        let scale = if args.width >= 192 { 2 } else { 1 };
+        draw_label(&mut img, 4, 4, p.label, scale);
+        draw_label(&mut img, 4, 4 + 9 * scale, &format!("{} spp", args.spp), scale);
+        images.push(img);
+    }
+    let rows = (images.len() as u32).div_ceil(columns);
+    let mut out = image::RgbImage::from_pixel(columns * args.width + (columns - 1) * GAP, rows * args.height + (rows - 1) * GAP, image::Rgb([255, 255, 255]));
+    for (k, img) in images.iter().enumerate() {
+        let (cx, cy) = (k as u32 % columns, k as u32 / columns);
+        image::imageops::replace(&mut out, img, (cx * (args.width + GAP)) as i64, (cy * (args.height + GAP)) as i64);
+    }
+    save_png(&out, &args.output)
+}
+
+/// Renders `spp` samples per pixel in submissions of about 2^18 samples (short dispatches on lavapipe).
+fn render(ctx: &GpuContext, renderer: &mut Renderer, spp: u32) -> Result<Film, String> {
+    let pixels = renderer.settings.width * renderer.settings.height;
+    let chunk = ((1u32 << 18) / pixels).clamp(1, 64);
+    let mut left = spp;
+    while left > 0 {
+        let n = left.min(chunk);
+        renderer.render(ctx, n).map_err(|e| e.to_string())?;
+        left -= n;
+    }
+    renderer.film(ctx).map_err(|e| e.to_string())
+}
+
+/// Writes a PNG through a temporary file and a rename (no truncated figure after an interruption).
+fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String> {
+    let tmp = path.with_extension("png.partial");
+    img.save_with_format(&tmp, image::ImageFormat::Png).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: could not write the figure: {e}", path.display())
+    })?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("{}: could not write the figure: {e}", path.display()))
+}
+
+/// Draws `text` (upper-cased; characters without a glyph become blanks) at (x, y) in white on a darkened box,
+/// each font pixel `scale`×`scale` image pixels. Clipped to the image.
+pub fn draw_label(img: &mut image::RgbImage, x: u32, y: u32, text: &str, scale: u32) {
+    let advance = 6 * scale;
+    let (w, h) = (text.chars().count() as u32 * advance + 2 * scale, 9 * scale);
+    for py in y..(y + h).min(img.height()) {
+        for px in x..(x + w).min(img.width()) {
+            let p = img.get_pixel_mut(px, py);
+            p.0 = p.0.map(|c| c / 4);
+        }
+    }
+    for (k, ch) in text.chars().enumerate() {
+        let Some(rows) = glyph(ch.to_ascii_uppercase()) else { continue };
+        for (r, row) in rows.iter().enumerate() {
+            for (c, bit) in row.bytes().enumerate() {
+                if bit != b'#' {
+                    continue;
+                }
+                for dy in 0..scale {
+                    for dx in 0..scale {
+                        let px = x + scale + k as u32 * advance + c as u32 * scale + dx;
+                        let py = y + scale + r as u32 * scale + dy;
+                        if px < img.width() && py < img.height() {
+                            img.put_pixel(px, py, image::Rgb([255, 255, 255]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The 5×7 glyph of an upper-case letter, digit or a few punctuation marks; None for anything else.
+fn glyph(c: char) -> Option<[&'static str; 7]> {
+    Some(match c {
+        'A' => [" ### ", "#   #", "#   #", "#####", "#   #", "#   #", "#   #"],
+        'B' => ["#### ", "#   #", "#   #", "#### ", "#   #", "#   #", "#### "],
+        'C' => [" ### ", "#   #", "#    ", "#    ", "#    ", "#   #", " ### "],
+        'D' => ["#### ", "#   #", "#   #", "#   #", "#   #", "#   #", "#### "],
+        'E' => ["#####", "#    ", "#    ", "#### ", "#    ", "#    ", "#####"],
+        'F' => ["#####", "#    ", "#    ", "#### ", "#    ", "#    ", "#    "],
+        'G' => [" ### ", "#   #", "#    ", "# ###", "#   #", "#   #", " ####"],
+        'H' => ["#   #", "#   #", "#   #", "#####", "#   #", "#   #", "#   #"],
+        'I' => [" ### ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### "],
+        'J' => ["  ###", "   # ", "   # ", "   # ", "   # ", "#  # ", " ##  "],
+        'K' => ["#   #", "#  # ", "# #  ", "##   ", "# #  ", "#  # ", "#   #"],
+        'L' => ["#    ", "#    ", "#    ", "#    ", "#    ", "#    ", "#####"],
+        'M' => ["#   #", "## ##", "# # #", "# # #", "#   #", "#   #", "#   #"],
+        'N' => ["#   #", "#   #", "##  #", "# # #", "#  ##", "#   #", "#   #"],
+        'O' => [" ### ", "#   #", "#   #", "#   #", "#   #", "#   #", " ### "],
+        'P' => ["#### ", "#   #", "#   #", "#### ", "#    ", "#    ", "#    "],
+        'Q' => [" ### ", "#   #", "#   #", "#   #", "# # #", "#  # ", " ## #"],
+        'R' => ["#### ", "#   #", "#   #", "#### ", "# #  ", "#  # ", "#   #"],
+        'S' => [" ####", "#    ", "#    ", " ### ", "    #", "    #", "#### "],
+        'T' => ["#####", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  "],
+        'U' => ["#   #", "#   #", "#   #", "#   #", "#   #", "#   #", " ### "],
+        'V' => ["#   #", "#   #", "#   #", "#   #", "#   #", " # # ", "  #  "],
+        'W' => ["#   #", "#   #", "#   #", "# # #", "# # #", "# # #", " # # "],
+        'X' => ["#   #", "#   #", " # # ", "  #  ", " # # ", "#   #", "#   #"],
+        'Y' => ["#   #", "#   #", " # # ", "  #  ", "  #  ", "  #  ", "  #  "],
+        'Z' => ["#####", "    #", "   # ", "  #  ", " #   ", "#    ", "#####"],
+        '0' => [" ### ", "#   #", "#  ##", "# # #", "##  #", "#   #", " ### "],
+        '1' => ["  #  ", " ##  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### "],
+        '2' => [" ### ", "#   #", "    #", "   # ", "  #  ", " #   ", "#####"],
+        '3' => ["#####", "   # ", "  #  ", "   # ", "    #", "#   #", " ### "],
+        '4' => ["   # ", "  ## ", " # # ", "#  # ", "#####", "   # ", "   # "],
+        '5' => ["#####", "#    ", "#### ", "    #", "    #", "#   #", " ### "],
+        '6' => ["  ## ", " #   ", "#    ", "#### ", "#   #", "#   #", " ### "],
+        '7' => ["#####", "    #", "   # ", "  #  ", " #   ", " #   ", " #   "],
+        '8' => [" ### ", "#   #", "#   #", " ### ", "#   #", "#   #", " ### "],
+        '9' => [" ### ", "#   #", "#   #", " ####", "    #", "   # ", " ##  "],
+        ' ' => ["     "; 7],
+        '-' => ["     ", "     ", "     ", "#####", "     ", "     ", "     "],
+        '.' => ["     ", "     ", "     ", "     ", "     ", " ##  ", " ##  "],
+        ',' => ["     ", "     ", "     ", "     ", " ##  ", "  #  ", " #   "],
+        ':' => ["     ", " ##  ", " ##  ", "     ", " ##  ", " ##  ", "     "],
+        '/' => ["    #", "    #", "   # ", "  #  ", " #   ", "#    ", "#    "],
+        '(' => ["   # ", "  #  ", " #   ", " #   ", " #   ", "  #  ", "   # "],
+        ')' => [" #   ", "  #  ", "   # ", "   # ", "   # ", "  #  ", " #   "],
+        '=' => ["     ", "     ", "#####", "     ", "#####", "     ", "     "],
+        '+' => ["     ", "  #  ", "  #  ", "#####", "  #  ", "  #  ", "     "],
+        '%' => ["##   ", "##  #", "   # ", "  #  ", " #   ", "#  ##", "   ##"],
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_glyph_is_5_by_7() {
+        for c in ('A'..='Z').chain('0'..='9').chain(" -.,:/()=+%".chars()) {
+            let g = glyph(c).unwrap_or_else(|| panic!("no glyph for {c:?}"));
+            assert!(g.iter().all(|r| r.len() == 5 && r.bytes().all(|b| b == b'#' || b == b' ')), "glyph {c:?}");
+        }
+    }
+
+    #[test]
+    fn labels_are_drawn_and_clipped() {
+        let mut img = image::RgbImage::from_pixel(40, 12, image::Rgb([200, 200, 200]));
+        draw_label(&mut img, 0, 0, "MIS 64 spp", 1);
+        assert!(img.pixels().any(|p| p.0 == [255, 255, 255]), "text must be drawn");
+        assert!(img.pixels().any(|p| p.0 == [50, 50, 50]), "the box behind it darkens the panel");
+    }
+
+    #[test]
+    fn unknown_and_unavailable_figures_are_errors() {
+        let base = Settings::default();
+        assert!(layout("nope", &base).unwrap_err().contains("expected one of"));
+        assert!(layout("samplers", &base).unwrap_err().contains("not yet"));
+        assert_eq!(layout("veach", &base).unwrap().2.len(), 4);
+        assert_eq!(layout("area-vs-cosine", &base).unwrap().2.len(), 3);
+    }
+}

@@ -1,0 +1,284 @@
+//! `mislab reference`: a converged reference image — MIS with the power heuristic and Owen-scrambled Sobol —
+//! written as linear EXR whose header records the sample count, the render time, the scene and every setting
+//! (custom attributes); and reading such references back for `mislab bench`.
+
+use crate::bench::{default_dispatch_spp, film_complete, TimedRender};
+use crate::film::Film;
+use crate::gpu::GpuContext;
+use crate::gpu_scene::{GpuScene, SceneData};
+use crate::progressive::{Budget, RenderStats};
+use crate::render::Renderer;
+use crate::scene::{self, Environment, LoadOptions, Scene};
+use crate::settings::*;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Seed of references (distinct from the seeds 0, 1, … that `mislab bench` measures, so the reference's
+/// error is independent of theirs).
+pub const REFERENCE_SEED: u32 = 0x5eed_f00d;
+
+/// The scene and its environment override, as on the command line.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SceneSpec {
+    /// A .gltf/.glb/.toml file or a built-in scene: veach-mis, cornell-box, furnace, area-vs-cosine.
+    #[arg(default_value = "veach-mis")]
+    pub scene: String,
+    /// glTF scene index (default: the file's default scene).
+    #[arg(long)]
+    pub gltf_scene: Option<usize>,
+    /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Scale of the --env map.
+    #[arg(long, default_value_t = 1.0)]
+    pub env_scale: f32,
+    /// Rotation of the --env map about +Y, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub env_rotation: f32,
+}
+
+impl SceneSpec {
+    /// Loads the scene and applies the environment override; prints the loader's warnings.
+    pub fn load(&self) -> Result<Scene, String> {
+        let mut s = scene::load(&self.scene, &LoadOptions { gltf_scene: self.gltf_scene }).map_err(|e| e.to_string())?;
+        if let Some(env) = &self.env {
+            let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| e.to_string())?;
+            s.warnings.extend(warnings);
+            s.environment = Environment::Map { map: Arc::new(map), scale: self.env_scale, rotation: self.env_rotation.to_radians() };
+        }
+        for w in &s.warnings {
+            eprintln!("warning: {}: {w}", self.scene);
+        }
+        Ok(s)
+    }
+}
+
+/// `mislab reference` flags.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ReferenceArgs {
+    #[command(flatten)]
+    pub scene: SceneSpec,
+    /// Output EXR.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Samples per pixel.
+    #[arg(long, conflicts_with = "time", required_unless_present = "time")]
+    pub spp: Option<u32>,
+    /// Render for this many seconds instead (after compilation).
+    #[arg(long)]
+    pub time: Option<f64>,
+    /// Image width.
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// direct or path.
+    #[arg(long, value_enum, default_value_t = Mode::Direct)]
+    pub mode: Mode,
+    /// Maximum path length (path mode).
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+    /// Area-light sampling inside MIS.
+    #[arg(long, value_enum, default_value_t = LightSampling::SolidAngle)]
+    pub light_sampling: LightSampling,
+    /// Environment sampling inside MIS.
+    #[arg(long, value_enum, default_value_t = EnvSampling::Importance)]
+    pub env_sampling: EnvSampling,
+    /// Light selection.
+    #[arg(long, value_enum, default_value_t = LightSelect::Uniform)]
+    pub light_select: LightSelect,
+    /// Seed.
+    #[arg(long, default_value_t = REFERENCE_SEED)]
+    pub seed: u32,
+}
+
+/// The reference estimator for a film and mode: MIS (multi-sample, power heuristic, one light and one BSDF
+/// sample), Owen-scrambled Sobol, `REFERENCE_SEED`.
+pub fn reference_settings(base: &Settings) -> Settings {
+    Settings {
+        strategy: Strategy::Mis,
+        heuristic: Heuristic::Power,
+        power_beta: 2.0,
+        mis: MisKind::Multi,
+        light_samples: 1,
+        bsdf_samples: 1,
+        sampler: SamplerKind::Sobol,
+        seed: REFERENCE_SEED,
+        ..base.clone()
+    }
+}
+
+/// Renders a reference to a budget in small, checked dispatches (see `bench`: lavapipe's loop budget).
+pub fn render_reference(ctx: &GpuContext, scene: &Scene, settings: &Settings, budget: Budget, dispatch_spp: u32) -> Result<(Film, RenderStats), String> {
+    let gpu_scene = GpuScene::upload(ctx, SceneData::build(scene)).map_err(|e| e.to_string())?;
+    let mut r = Renderer::new(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?;
+    let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { default_dispatch_spp(settings.mode) };
+    for _attempt in 0..8 {
+        r.reset();
+        let timed = TimedRender::new(ctx, dispatch);
+        let start = Instant::now();
+        let (mut seconds, mut rays) = (0.0, 0u64);
+        // Submissions of about a second, so a time budget is met closely.
+        let mut chunk = dispatch;
+        loop {
+            let n = match budget {
+                Budget::Samples(total) => chunk.min(total - r.samples),
+                Budget::Time(t) => {
+                    if r.samples > 0 && start.elapsed() >= t {
+                        0
+                    } else {
+                        chunk
+                    }
+                }
+            };
+            if n == 0 {
+                break;
+            }
+            let t = timed.render(ctx, &mut r, n)?;
+            seconds += t.wall;
+            rays += t.rays;
+            if t.wall < 0.5 {
+                chunk = (chunk * 2).min(1 << 16);
+            }
+            if let Budget::Time(limit) = budget {
+                let per = seconds / r.samples as f64;
+                let left = limit.saturating_sub(start.elapsed()).as_secs_f64();
+                chunk = chunk.min(((left / per.max(1e-9)).ceil() as u32).max(1));
+            }
+        }
+        let film = r.film(ctx).map_err(|e| e.to_string())?;
+        if film_complete(&film, r.samples) {
+            let stats = RenderStats { spp: r.samples, seconds, rays, nonfinite: r.nonfinite_total, interrupted: false };
+            return Ok((film, stats));
+        }
+        if dispatch == 1 {
+            break;
+        }
+        dispatch /= 2;
+        eprintln!("reference: lavapipe's loop budget dropped samples; retrying with {dispatch} spp per dispatch");
+    }
+    Err("pixels miss samples even with 1 spp per dispatch".into())
+}
+
+/// The custom header attributes of a reference: spp, seconds, scene, settings (JSON), software.
+pub fn header_attributes(scene: &SceneSpec, settings: &Settings, stats: &RenderStats) -> Vec<(String, String)> {
+    vec![
+        ("spp".into(), stats.spp.to_string()),
+        ("renderSeconds".into(), format!("{:.3}", stats.seconds)),
+        ("nonfiniteSamples".into(), stats.nonfinite.to_string()),
+        ("scene".into(), scene.scene.clone()),
+        ("environment".into(), scene.env.as_ref().map(|p| p.display().to_string()).unwrap_or_default()),
+        ("envScale".into(), scene.env_scale.to_string()),
+        ("envRotation".into(), scene.env_rotation.to_string()),
+        ("mislabSettings".into(), serde_json::to_string(settings).unwrap_or_default()),
+        ("mislabVersion".into(), env!("CARGO_PKG_VERSION").to_string()),
+    ]
+}
+
+fn text(s: &str) -> exr::meta::attribute::Text {
+    use exr::meta::attribute::Text;
+    Text::new_or_none(s).unwrap_or_else(|| Text::new_or_panic(s.chars().map(|c| if (c as u32) < 256 { c } else { '?' }).collect::<String>()))
+}
+
+/// Writes linear RGB float32 EXR with `attributes` as text attributes of the layer (written to a temporary
+/// file and renamed).
+pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), String> {
+    use exr::prelude::*;
+    let (w, h) = (film.width as usize, film.height as usize);
+    let mut layer_attributes = LayerAttributes::named("reference");
+    layer_attributes.software_name = Some(text("mislab"));
+    for (k, v) in attributes {
+        layer_attributes.other.insert(text(k), AttributeValue::Text(text(v)));
+    }
+    let pixels = &film.mean;
+    let layer = Layer::new(
+        (w, h),
+        layer_attributes,
+        Encoding::FAST_LOSSLESS,
+        SpecificChannels::rgb(|p: Vec2<usize>| {
+            let c = pixels[p.y() * w + p.x()];
+            (c[0], c[1], c[2])
+        }),
+    );
+    let tmp = path.with_extension("exr.partial");
+    Image::from_layer(layer).write().to_file(&tmp).map_err(|e| format!("{}: could not write the EXR: {e}", path.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// A reference read back: size, linear RGB pixels, and its text attributes.
+#[derive(Clone, Debug)]
+pub struct ReferenceImage {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Row-major RGB.
+    pub pixels: Vec<[f32; 3]>,
+    /// Text attributes of the first layer (empty for EXRs from elsewhere).
+    pub attributes: BTreeMap<String, String>,
+}
+
+/// Reads an EXR (any writer) and, where present, the attributes `write_exr` records.
+pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
+    let img = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.into_rgb32f();
+    let (width, height) = img.dimensions();
+    let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
+    let mut attributes = BTreeMap::new();
+    if let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) {
+        if let Some(header) = meta.headers.first() {
+            for (k, v) in &header.own_attributes.other {
+                if let exr::meta::attribute::AttributeValue::Text(t) = v {
+                    attributes.insert(k.to_string(), t.to_string());
+                }
+            }
+        }
+    }
+    Ok(ReferenceImage { width, height, pixels, attributes })
+}
+
+/// Runs `mislab reference`.
+pub fn run(args: &ReferenceArgs) -> Result<(), String> {
+    let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    if ext.as_deref() != Some("exr") {
+        return Err(format!("{}: a reference is written as .exr", args.output.display()));
+    }
+    let budget = match (args.spp, args.time) {
+        (Some(0), _) => return Err("--spp must be at least 1".into()),
+        (Some(n), _) => Budget::Samples(n),
+        (None, Some(t)) if t.is_finite() && t > 0.0 => Budget::Time(Duration::from_secs_f64(t)),
+        (None, Some(t)) => return Err(format!("--time {t} must be a positive number of seconds")),
+        (None, None) => return Err("give --spp N or --time SECONDS".into()),
+    };
+    let base = Settings {
+        width: args.width,
+        height: args.height,
+        mode: args.mode,
+        max_depth: args.max_depth,
+        light_sampling: args.light_sampling,
+        env_sampling: args.env_sampling,
+        light_select: args.light_select,
+        ..Settings::default()
+    };
+    let settings = Settings { seed: args.seed, ..reference_settings(&base) };
+    settings.validate()?;
+    let ctx = GpuContext::new().map_err(|e| e.to_string())?;
+    eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
+    let scene = args.scene.load()?;
+    let t = Instant::now();
+    let (film, stats) = render_reference(&ctx, &scene, &settings, budget, 0)?;
+    write_exr(&args.output, &film, &header_attributes(&args.scene, &settings, &stats))?;
+    let pixels = (settings.width * settings.height) as f64;
+    eprintln!(
+        "{} spp in {:.2} s ({:.2} s with compilation): {:.2} M samples/s, {} NaN/Inf samples; wrote {}",
+        stats.spp,
+        stats.seconds,
+        t.elapsed().as_secs_f64(),
+        stats.spp as f64 * pixels / stats.seconds.max(1e-9) / 1e6,
+        stats.nonfinite,
+        args.output.display()
+    );
+    Ok(())
+}
