@@ -957,6 +957,42 @@ mod tests {
     }
 
     #[test]
+    fn plane_window_and_thin_supports() {
+        // Uniform points on a long thin triangle seen nearly edge-on, as directions; pdf = d² / (A cos).
+        let p = DVec3::new(0.0, 0.0, 0.05);
+        let v = [DVec3::new(1.0, -0.5, 0.0), DVec3::new(3.0, -0.4, 0.0), DVec3::new(1.2, 0.6, 0.0)];
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let area = 0.5 * n.length();
+        let mut rng = Pcg64::seed_from_u64(21);
+        let samples: Vec<Option<DVec3>> = (0..300_000)
+            .map(|_| {
+                let (mut a, mut b): (f64, f64) = (rng.random(), rng.random());
+                if a + b > 1.0 {
+                    (a, b) = (1.0 - a, 1.0 - b);
+                }
+                Some((v[0] + a * (v[1] - v[0]) + b * (v[2] - v[0]) - p).normalize())
+            })
+            .collect();
+        let domain = PlaneWindow { p, origin: DVec3::new(0.8, -0.7, 0.0), e1: DVec3::new(2.4, 0.0, 0.0), e2: DVec3::new(0.0, 1.5, 0.0), grid: (100, 200) };
+        let pdf = |w: &DVec3| {
+            let t = -p.z / w.z;
+            let y = p + t * *w;
+            let e = [v[1] - v[0], v[2] - v[0]];
+            let b1 = (y - v[0]).cross(e[1]).dot(n) / n.dot(n);
+            let b2 = e[0].cross(y - v[0]).dot(n) / n.dot(n);
+            if t > 0.0 && b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 { t * t / (area * w.z.abs()) } else { 0.0 }
+        };
+        let r = Chi2Test::new("thin triangle", &domain).run(&samples, &mut |pts| pts.iter().map(pdf).collect());
+        assert!(r.passed(), "{}", r.summary());
+        assert!((r.integral - 1.0).abs() < 1e-3, "{}", r.summary());
+        // A sample outside the window fails outright.
+        let mut bad = samples.clone();
+        bad[3] = Some(DVec3::new(0.0, 0.0, -1.0));
+        let r = Chi2Test::new("outside", &domain).run(&bad, &mut |pts| pts.iter().map(pdf).collect());
+        assert!(!r.passed(), "{}", r.summary());
+    }
+
+    #[test]
     fn discrete() {
         let pmf = [0.5, 0.25, 0.125, 0.125, 0.0];
         let mut rng = Pcg64::seed_from_u64(1);

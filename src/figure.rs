@@ -46,6 +46,7 @@ pub const FIGURES: &[&str] = &["veach", "area-vs-cosine", "samplers"];
 const GAP: u32 = 4;
 
 /// One panel: its label and settings.
+#[derive(Debug)]
 struct Panel {
     label: &'static str,
     settings: Settings,
@@ -61,8 +62,8 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
             vec![
                 Panel { label: "light sampling", settings: with(Strategy::Light) },
                 Panel { label: "BSDF sampling", settings: with(Strategy::Bsdf) },
-                Panel { label: "MIS: balance heuristic", settings: Settings { heuristic: Heuristic::Balance, ..with(Strategy::Mis) } },
-                Panel { label: "MIS: power heuristic", settings: Settings { heuristic: Heuristic::Power, ..with(Strategy::Mis) } },
+                Panel { label: "MIS, balance", settings: Settings { heuristic: Heuristic::Balance, ..with(Strategy::Mis) } },
+                Panel { label: "MIS, power", settings: Settings { heuristic: Heuristic::Power, ..with(Strategy::Mis) } },
             ],
         )),
         "area-vs-cosine" => Ok((
@@ -127,10 +128,17 @@ fn render(ctx: &GpuContext, renderer: &mut Renderer, spp: u32) -> Result<Film, S
     renderer.film(ctx).map_err(|e| e.to_string())
 }
 
-/// Writes a PNG through a temporary file and a rename (no truncated figure after an interruption).
+/// Writes a PNG through a temporary file and a rename (no truncated figure after an interruption); a figure
+/// whose every pixel is grey (both built-in figures) is stored as 8-bit greyscale, a third of the size.
 fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String> {
     let tmp = path.with_extension("png.partial");
-    img.save_with_format(&tmp, image::ImageFormat::Png).map_err(|e| {
+    let grey = img.pixels().all(|p| p.0[0] == p.0[1] && p.0[1] == p.0[2]);
+    let result = if grey {
+        image::GrayImage::from_fn(img.width(), img.height(), |x, y| image::Luma([img.get_pixel(x, y).0[0]])).save_with_format(&tmp, image::ImageFormat::Png)
+    } else {
+        img.save_with_format(&tmp, image::ImageFormat::Png)
+    };
+    result.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         format!("{}: could not write the figure: {e}", path.display())
     })?;

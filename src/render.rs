@@ -343,11 +343,27 @@ impl Renderer {
 
     /// Renders `spp` more samples per pixel in one submission and waits for them (with the device timeout).
     pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), GpuError> {
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        self.encode(&mut enc, spp);
-        self.queue.submit([enc.finish()]);
+        // lavapipe (Mesa 22.3) gives each invocation one budget of 65535 loop iterations shared by all
+        // its loops and silently stops looping when it is spent: a 1024-spp dispatch accumulated only
+        // ~300-450 samples. Split into small dispatches (one submit each, so each sees its own
+        // parameters) and wait once at the end.
+        let chunk = self.max_dispatch_spp();
+        let mut left = spp;
+        while left > 0 {
+            let n = left.min(chunk);
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            self.encode(&mut enc, n);
+            self.queue.submit([enc.finish()]);
+            left -= n;
+        }
         ctx.wait()?;
         self.collect_counters(ctx)
+    }
+
+    /// Most samples per pixel one dispatch may take without exhausting a driver's per-invocation loop
+    /// budget (path tracing runs far more traversal steps per sample than direct lighting).
+    pub fn max_dispatch_spp(&self) -> u32 {
+        if self.settings.mode == Mode::Path { 4 } else { 16 }
     }
 
     /// Adds the device counters to the host totals and clears them (u32 on the device would overflow).

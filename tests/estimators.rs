@@ -723,8 +723,10 @@ fn area_vs_cosine_direct() {
     let base = small(SCENE_SIZE, SCENE_SIZE);
     let r = reference("area-vs-cosine direct", &mut bench, &base, 2048);
     let light = |ls: LightSampling| Config { label: format!("light/{}", ls.name()), light_sampling: ls, ..cfg(Strategy::Light) };
-    for c in [light(LightSampling::SolidAngle), light(LightSampling::Area), cfg(Strategy::Mis)] {
-        check_config("area-vs-cosine direct", &mut bench, &r, &base, &c, 256, Check::PerPixel(None));
+    // Area sampling's r⁻² noise beside the light: at 256 spp 2 of 1024 pixels disagreed (the most the criterion
+    // allows), at 1024 spp 1 (measured) — so 1024.
+    for (c, spp) in [(light(LightSampling::SolidAngle), 256), (light(LightSampling::Area), 1024), (cfg(Strategy::Mis), 256)] {
+        check_config("area-vs-cosine direct", &mut bench, &r, &base, &c, spp, Check::PerPixel(None));
     }
     // Uniform sampling sees the low, wide light from the far floor with probability ≥ ~0.1% per sample (its
     // solid angle over 2π): at 4096 spp 4 pixels still disagreed, at 16384 one (of 1024; the criterion allows 2).
@@ -922,136 +924,4 @@ fn veach_mis_power_heuristic_is_never_much_worse_than_the_better_technique() {
         }
     }
     assert!(failures.is_empty(), "the power heuristic is more than 1.1× worse than the better technique in: {}", failures.join("; "));
-}
-
-// ---------------------------------------------------------------------------------------------------
-// Exploration (temporary)
-
-#[test]
-fn explore() {
-    let Ok(which) = std::env::var("MISLAB_EXPLORE") else { return };
-    let (name, mode, w, h, ref_spp, checkpoints): (&str, Mode, u32, u32, u32, Vec<u32>) = match which.as_str() {
-        "veach-direct" => ("veach-mis", Mode::Direct, 64, 64, 1024, vec![64, 256, 1024]),
-        "cornell-direct" => ("cornell-box", Mode::Direct, 32, 32, 2048, vec![64, 256, 1024, 4096]),
-        "avc-direct" => ("area-vs-cosine", Mode::Direct, 32, 32, 2048, vec![256, 1024, 4096, 16384]),
-        "cornell-path" => ("cornell-box", Mode::Path, 32, 32, 1024, vec![64, 256, 1024]),
-        "avc-path" => ("area-vs-cosine", Mode::Path, 32, 32, 1024, vec![256, 1024, 4096]),
-        "veach-path" => ("veach-mis", Mode::Path, 32, 32, 512, vec![64, 256, 512]),
-        _ => return,
-    };
-    let only: Option<Vec<String>> = std::env::var("MISLAB_ONLY").ok().map(|s| s.split(',').map(String::from).collect());
-    let sc = scene(name);
-    let mut b = Bench::new(&sc, w, h);
-    let base = Settings { mode, max_depth: 4, ..small(w, h) };
-    let t = std::time::Instant::now();
-    let reference = b.render(&Settings { seed: 1000, ..base.clone() }, ref_spp);
-    eprintln!("reference {ref_spp} spp: {:.1}s", t.elapsed().as_secs_f64());
-    for c in every_config() {
-        if let Some(o) = &only {
-            if !o.contains(&c.label) {
-                continue;
-            }
-        }
-        let t = std::time::Instant::now();
-        let mut done = 0;
-        for (k, &cp) in checkpoints.iter().enumerate() {
-            let film = if k == 0 { b.render(&c.apply(&base), cp) } else { b.more(cp - done) };
-            done = cp;
-            let a = compare(&film, &reference, None);
-            eprintln!(
-                "{name} {mode:?} {:>18} {cp:>6} spp ({:>5.1}s): agree {:.2}% ({} bad) worst {:.1} agg {:.2}",
-                c.label,
-                t.elapsed().as_secs_f64(),
-                100.0 * a.fraction(),
-                a.pixels - a.agree,
-                a.worst.0,
-                a.aggregate_z[1]
-            );
-        }
-    }
-}
-
-#[test]
-fn explore_analytic() {
-    if std::env::var("MISLAB_EXPLORE").as_deref() != Ok("analytic") {
-        return;
-    }
-    let sc = analytic_scene();
-    let (w, h) = (32, 32);
-    let t = std::time::Instant::now();
-    let expected = analytic_expected(&sc.camera, w, h);
-    eprintln!("expected values: {:.2}s, {} of {} pixels", t.elapsed().as_secs_f64(), expected.iter().flatten().count(), w * h);
-    let (exact, mask) = exact_film(&expected, w, h);
-    exact.save(std::path::Path::new("/tmp/ws/analytic_exact.png"), 0.0, Default::default()).unwrap();
-    let mut b = Bench::new(&sc, w, h);
-    let base = small(w, h);
-    for c in every_config() {
-        let t = std::time::Instant::now();
-        let mut done = 0;
-        for (k, &cp) in [64u32, 256, 1024, 4096].iter().enumerate() {
-            let film = if k == 0 { b.render(&c.apply(&base), cp) } else { b.more(cp - done) };
-            done = cp;
-            if k == 0 && c.strategy == Strategy::Mis {
-                film.save(std::path::Path::new("/tmp/ws/analytic_mis.png"), 0.0, Default::default()).unwrap();
-            }
-            let a = compare(&film, &exact, Some(&mask));
-            eprintln!(
-                "analytic {:>18} {cp:>6} spp ({:>5.1}s): agree {:.2}% ({} bad) worst {:.1} agg {:.2} {:.2} {:.2}",
-                c.label,
-                t.elapsed().as_secs_f64(),
-                100.0 * a.fraction(),
-                a.pixels - a.agree,
-                a.worst.0,
-                a.aggregate_z[0],
-                a.aggregate_z[1],
-                a.aggregate_z[2]
-            );
-        }
-    }
-}
-
-#[test]
-fn explore_bad() {
-    let Ok(which) = std::env::var("MISLAB_BAD") else { return };
-    let mut it = which.split(':');
-    let (name, mode, strat, spp, w) = (it.next().unwrap(), it.next().unwrap(), it.next().unwrap(), it.next().unwrap().parse::<u32>().unwrap(), it.next().unwrap().parse::<u32>().unwrap());
-    let mode: Mode = mode.parse().unwrap();
-    let sc = scene(name);
-    let mut b = Bench::new(&sc, w, w);
-    let base = Settings { mode, max_depth: 4, ..small(w, w) };
-    let reference = b.render(&Settings { seed: 1000, ..base.clone() }, if name == "veach-mis" { 1024 } else { 2048 });
-    let c = every_config().into_iter().find(|c| c.label == strat).unwrap();
-    let film = b.render(&c.apply(&base), spp);
-    let plates = veach_plate_pixels(&sc.camera, w, w);
-    let not_plates: Vec<bool> = plates.iter().map(|p| !p).collect();
-    let a = compare(&film, &reference, None);
-    eprintln!("agree {:.2}% limit {:.2}", 100.0 * a.fraction(), a.z_limit);
-    if name == "veach-mis" {
-        let regions = veach_regions(&sc.camera, w, w);
-        for y in 0..w { eprintln!("R {}", (0..w).map(|x| match regions[(y*w+x) as usize] { Some((p, c)) => char::from(b'a' + (p * 4 + c) as u8), None => if plates[(y*w+x) as usize] {'#'} else {'.'} }).collect::<String>()); }
-        let a = compare(&film, &reference, Some(&plates));
-        eprintln!("plates: agree {:.2}% ({} bad of {}) limit {:.2}", 100.0 * a.fraction(), a.pixels - a.agree, a.pixels, a.z_limit);
-        let a = compare(&film, &reference, Some(&not_plates));
-        eprintln!("not plates: agree {:.2}% ({} bad of {}) limit {:.2}", 100.0 * a.fraction(), a.pixels - a.agree, a.pixels, a.z_limit);
-    }
-    let mut map = vec!['.'; (w * w) as usize];
-    for i in 0..film.mean.len() {
-        let vx = film.variance_of_mean(i).unwrap();
-        let vr = reference.variance_of_mean(i).unwrap();
-        let z = (film.mean[i][1] as f64 - reference.mean[i][1] as f64) / (vx[1] + vr[1]).sqrt();
-        if z.abs() >= a.z_limit {
-            map[i] = if z < 0.0 { '-' } else { '+' };
-            eprintln!("({}, {}) x {:.4e} r {:.4e} se_x {:.2e} se_r {:.2e} z {z:.1}", i as u32 % w, i as u32 / w, film.mean[i][1], reference.mean[i][1], vx[1].sqrt(), vr[1].sqrt());
-        }
-    }
-    for y in 0..w { eprintln!("{}", map[(y * w) as usize..((y + 1) * w) as usize].iter().collect::<String>()); }
-}
-#[test]
-fn explore_figure() {
-    let Ok(which) = std::env::var("MISLAB_FIGURE") else { return };
-    let spp: u32 = std::env::var("MISLAB_FIGURE_SPP").ok().and_then(|s| s.parse().ok()).unwrap_or(64);
-    let size: u32 = std::env::var("MISLAB_FIGURE_SIZE").ok().and_then(|s| s.parse().ok()).unwrap_or(256);
-    let t = std::time::Instant::now();
-    mislab::figure::run(&mislab::figure::FigureArgs { which: which.clone(), output: format!("/tmp/ws/fig-{which}-{spp}-{size}.png").into(), spp, width: size, height: size, seed: 0 }).unwrap();
-    eprintln!("figure {which}: {:.1}s", t.elapsed().as_secs_f64());
 }

@@ -118,3 +118,16 @@ fn specialised_and_generic_pipelines_agree() {
         assert!(worst < 1e-4, "{name}: specialised and generic images differ by {worst} (relative)");
     }
 }
+
+/// Every requested sample reaches the film even when one call asks for many (lavapipe silently stops
+/// a shader's loops after 65535 iterations per invocation, so large dispatches used to drop samples).
+#[test]
+fn large_requests_keep_every_sample() {
+    let ctx = gpu();
+    let scene = scene("cornell-box");
+    let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::gpu_scene::SceneData::build(&scene)).unwrap();
+    let mut r = mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), Settings { mode: Mode::Path, ..small(8, 8) }).unwrap();
+    r.render(&ctx, 512).unwrap();
+    let film = r.film(&ctx).unwrap();
+    assert!(film.count.iter().zip(&film.nonfinite).all(|(c, b)| c + b == 512), "samples were dropped: {:?}", &film.count[..4]);
+}

@@ -695,14 +695,18 @@ fn bench_from_toml() {
     assert!(BenchCli::try_parse_from(["bench", "--suite", "lecture", "--config", &cfg]).map(|c| c.args.groups().is_err()).unwrap_or(true));
 }
 
-/// The lecture suite, end to end (minutes on lavapipe; `cargo test --release --test samplers -- --ignored`).
-/// MISLAB_SUITE_OUT sets the output directory (default: a scratch directory).
+/// The lecture suite, end to end (about half an hour on a loaded 2-core lavapipe machine;
+/// `cargo test --release --test samplers -- --ignored`). MISLAB_SUITE_OUT sets the output directory (default: a
+/// scratch directory); MISLAB_BENCH_ARGS, if set, replaces `--suite lecture` with other `mislab bench` arguments
+/// (whitespace-separated), e.g. `--config bench.toml`.
 #[test]
 #[ignore]
 fn lecture_suite_end_to_end() {
     use clap::Parser;
     let out = std::env::var("MISLAB_SUITE_OUT").unwrap_or_else(|_| scratch("suite").to_string_lossy().into_owned());
-    let cli = BenchCli::parse_from(["bench", "--suite", "lecture", "--out", &out]);
+    let extra = std::env::var("MISLAB_BENCH_ARGS").unwrap_or_else(|_| "--suite lecture".into());
+    let args: Vec<String> = ["bench".to_string()].into_iter().chain(extra.split_whitespace().map(String::from)).chain(["--out".into(), out.clone()]).collect();
+    let cli = BenchCli::parse_from(args);
     mislab::bench::run(&cli.args).unwrap();
     assert!(std::path::Path::new(&out).join("results.csv").exists());
 }

@@ -1535,5 +1535,3 @@ fn mine_spherical_triangle(va: DVec3, vb: DVec3, vc: DVec3, u: [f64; 2]) -> DVec
     let perp = (delta - delta.dot(bn) * bn).normalize();
     ((1.0 - omc) * bn + sin_theta * perp).normalize()
 }
-
-

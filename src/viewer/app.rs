@@ -605,7 +605,15 @@ fn legend(ui: &mut egui::Ui, view: View, range: [f32; 2]) {
     let mut d = first;
     while d <= last {
         let x = rect.left() + rect.width() * (d as f32 - lo) / (hi - lo);
-        p2.text(Pos2::new(x, tick_rect.top()), egui::Align2::CENTER_TOP, format!("1e{d}"), egui::FontId::monospace(10.0), ui.visuals().text_color());
+        // Keep the end labels inside the bar's width.
+        let align = if x < rect.left() + 12.0 {
+            egui::Align2::LEFT_TOP
+        } else if x > rect.right() - 12.0 {
+            egui::Align2::RIGHT_TOP
+        } else {
+            egui::Align2::CENTER_TOP
+        };
+        p2.text(Pos2::new(x, tick_rect.top()), align, format!("1e{d}"), egui::FontId::monospace(10.0), ui.visuals().text_color());
         d += step;
     }
 }

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 pub const PREVIEW_SCALE: u32 = 8;
 /// GPU time one engine frame aims at, all sides together. It bounds how long a new command waits for
 /// the dispatch in flight, and leaves the CPU (lavapipe = the CPU) to the window between frames.
-pub const FRAME_BUDGET_S: f64 = 0.030;
+pub const FRAME_BUDGET_S: f64 = 0.020;
 /// Sample counts stop growing here (the image has long converged; the CPU goes back to idle).
 pub const MAX_SPP: u32 = 1 << 16;
 /// How often the statistics are summed over the whole film (they cost a pass over every pixel).
