@@ -185,7 +185,7 @@ fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> Ligh
     let omega = triangle_light_omega(v0, v1, v2, p);
     if (omega == 0.0) { return no_light_sample(); }
     if (omega < 0.0) { return triangle_sample_li(prim, p, u); }
-    let wi = square_to_spherical_triangle(u, v0 - p, v1 - p, v2 - p);
+    let wi = spherical_triangle_warp(u, v0 - p, v1 - p, v2 - p, omega);
     // The light point: wi meets the triangle's plane at t = (v0 − p)·n / (wi·n).
     let n = cross(v1 - v0, v2 - v0);
     let t = dot(v0 - p, n) / dot(wi, n);

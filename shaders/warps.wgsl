@@ -156,6 +156,14 @@ fn spherical_triangle_solid_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f
 /// from ĉ′ − b̂ or from ĉ′ + b̂, whichever is shorter, so arcs that end nearly opposite b̂ (viewpoints near the
 /// triangle's plane) keep their precision too.
 fn square_to_spherical_triangle(u: vec2<f32>, va: vec3<f32>, vb: vec3<f32>, vc: vec3<f32>) -> vec3<f32> {
+    return spherical_triangle_warp(u, va, vb, vc, spherical_triangle_solid_angle(va, vb, vc));
+}
+fn square_to_spherical_triangle_pdf(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    return 1.0 / spherical_triangle_solid_angle(a, b, c);
+}
+
+/// `square_to_spherical_triangle` for a caller that already has Ω = `spherical_triangle_solid_angle(va, vb, vc)`.
+fn spherical_triangle_warp(u: vec2<f32>, va: vec3<f32>, vb: vec3<f32>, vc: vec3<f32>, omega: f32) -> vec3<f32> {
     // Any labelling samples the same density. Take as the base a–c (the arc ĉ′ runs along) the shortest side:
     // a base of nearly 180° (a viewpoint near a vertex or an edge, close to the triangle's plane) would put ĉ′
     // where it moves fastest with φ.
@@ -178,7 +186,6 @@ fn square_to_spherical_triangle(u: vec2<f32>, va: vec3<f32>, vb: vec3<f32>, vc: 
     let e2 = c - a;
     let an = a / la;
     let bn = b / lb;
-    let omega = spherical_triangle_solid_angle(a, b, c);
     // ŵ ⊥ â towards ĉ: (a × c) × a with a × c = a × e2 (exact for nearby vertices).
     let w = normalize(cross(cross(a, e2), a));
     let d = abs(dot(cross(a, e1), w)) / (la * lb);     // |[â, b̂, ŵ]|
@@ -200,9 +207,6 @@ fn square_to_spherical_triangle(u: vec2<f32>, va: vec3<f32>, vb: vec3<f32>, vc: 
     let dd = select(dm, dp, dot(dp, dp) < dot(dm, dm));
     let perp = normalize(dd - dot(dd, bn) * bn);
     return normalize((1.0 - omc) * bn + sin_theta * perp);
-}
-fn square_to_spherical_triangle_pdf(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
-    return 1.0 / spherical_triangle_solid_angle(a, b, c);
 }
 
 /// A rectangle prepared for solid-angle sampling, in its local frame: the viewpoint at the origin, the rectangle

@@ -6,7 +6,7 @@
 //!   sampling on the rough plates under the small lights, MIS is good everywhere.
 //! - `area-vs-cosine`: the lecture's slides of a floor under a low area light — light sampling by area (noisy
 //!   near the light: the r⁻² term), cosine sampling (noisy far from it: the light's small solid angle), and MIS.
-//! - `samplers`: not yet — the sample-sequence figure comes with the sampler comparison.
+//! - `samplers`: each sequence's 2D points and error power spectrum at low spp (`sampler_figure`).
 
 use crate::film::{Film, Tonemap};
 use crate::gpu::GpuContext;
@@ -20,7 +20,7 @@ use std::path::PathBuf;
 #[derive(clap::Args, Clone, Debug)]
 pub struct FigureArgs {
     /// Which figure: veach (light / BSDF / balance / power on Veach's plates), area-vs-cosine (area / cosine / MIS)
-    /// or samplers (not yet available).
+    /// or samplers (each sequence's points and error spectrum).
     pub which: String,
     /// Output PNG.
     #[arg(short, long, default_value = "figure.png")]
@@ -75,13 +75,17 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
                 Panel { label: "MIS", settings: with(Strategy::Mis) },
             ],
         )),
-        "samplers" => Err("figure 'samplers': not yet available (it comes with the sample-sequence comparison)".into()),
+        "samplers" => unreachable!("drawn by sampler_figure"),
         other => Err(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", "))),
     }
 }
 
 /// Renders the figure `args.which` and writes it to `args.output` (PNG).
 pub fn run(args: &FigureArgs) -> Result<(), String> {
+    if args.which == "samplers" {
+        // One column per sampler, four rows (two point sets, two spectra), each about a panel in size.
+        return crate::sampler_figure::run(&args.output, (args.width * 6).clamp(200, 16384), (args.height * 4).clamp(200, 16384));
+    }
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("png") {
         return Err(format!("{}: figures are written as PNG (use a .png name)", args.output.display()));

@@ -36,6 +36,8 @@ enum Command {
     Bench(mislab::bench::BenchArgs),
     /// Open the interactive viewer: the image converges while a panel switches estimators live.
     View(mislab::viewer::ViewArgs),
+    /// Reproduce a lecture figure: veach (light / BSDF / balance / power), area-vs-cosine, samplers.
+    Figure(mislab::figure::FigureArgs),
     /// Print the Vulkan adapters, the chosen one and its limits; with a scene, its statistics.
     Info {
         /// A scene file or built-in name.
@@ -194,6 +196,7 @@ fn main() -> ExitCode {
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
         Command::Reference(args) => mislab::reference::run(&args).map(|_| 0).map_err(bad),
         Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
+        Command::Figure(args) => mislab::figure::run(&args).map(|_| 0).map_err(bad),
     };
     match result {
         Ok(code) => ExitCode::from(code),
@@ -250,7 +253,15 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     }
     let budget = match (args.spp, args.time) {
         (Some(0), _) => return Err(bad("--spp must be at least 1")),
-        (Some(n), _) => Budget::Samples(n),
+        (Some(n), _) => {
+            // Hammersley and stratified build their points for a fixed count: refuse or round with a message.
+            let used = mislab::samplers::check_spp(settings.sampler, n).map_err(bad)?;
+            let note = mislab::samplers::spp_message(settings.sampler, n, used);
+            if !note.is_empty() {
+                eprintln!("note: {note}");
+            }
+            Budget::Samples(used)
+        }
         (None, Some(t)) if t.is_finite() && t > 0.0 => Budget::Time(Duration::from_secs_f64(t)),
         (None, Some(t)) => return Err(bad(format!("--time {t} must be a positive number of seconds"))),
         (None, None) => Budget::Samples(64),
@@ -263,11 +274,12 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         let flag = interrupt.clone();
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
+    // The scene first: a bad file is reported without waiting for (or needing) a device.
+    let scene = load_scene(&args.scene)?;
+    let t_loaded = Instant::now();
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let t_device = Instant::now();
-    let scene = load_scene(&args.scene)?;
-    let t_loaded = Instant::now();
     let data = SceneData::build(&scene);
     eprintln!(
         "scene: {} — {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights; BVH {} nodes built in {:.1} ms, {:.1} MiB ({:.0} B/triangle)",
@@ -288,14 +300,17 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     }
     let gpu_scene = GpuScene::upload(&ctx, data).map_err(|e| bad(format!("{}: {e}", args.scene.scene)))?;
     let mut renderer = Renderer::new(&ctx, &gpu_scene, scene.camera.clone(), settings.clone()).map_err(bad)?;
+    if let Budget::Samples(n) = budget {
+        renderer.sampler_spp = n;
+    }
     ctx.wait().map_err(|e| bad(e.to_string()))?;
     let t_ready = Instant::now();
     eprintln!(
-        "start-up: {:.2} s (device {:.2} s, scene load {:.2} s, BVH + upload + shader compilation {:.2} s) — not counted in the render time",
+        "start-up: {:.2} s (scene load {:.2} s, device {:.2} s, BVH + upload + shader compilation {:.2} s) — not counted in the render time",
         (t_ready - t_start).as_secs_f64(),
-        (t_device - t_start).as_secs_f64(),
-        (t_loaded - t_device).as_secs_f64(),
-        (t_ready - t_loaded).as_secs_f64()
+        (t_loaded - t_start).as_secs_f64(),
+        (t_device - t_loaded).as_secs_f64(),
+        (t_ready - t_device).as_secs_f64()
     );
     if interrupt.load(Ordering::SeqCst) {
         eprintln!("interrupted during start-up: nothing was rendered and no image was written");
