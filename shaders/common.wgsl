@@ -197,6 +197,11 @@ struct FrameParams {
     row_offset: u32,
     /// Rows this dispatch renders from `row_offset` (the dispatch covers ceil(row_count / 8) workgroup rows).
     row_count: u32,
+    /// Length scale of the scene around the render origin (≤ 1); see offset_ray_origin_scaled.
+    offset_scale: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;

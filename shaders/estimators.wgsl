@@ -61,7 +61,7 @@ fn direction_sample(c: ShadingCtx, j: u32) -> vec4<f32> {
 
 /// Spawns a ray leaving the surface along world direction w (offset to the side w points to).
 fn spawn_origin(x: Surface, w: vec3<f32>) -> vec3<f32> {
-    return offset_ray_origin(x.p, select(-x.ng, x.ng, dot(w, x.ng) > 0.0));
+    return offset_ray_origin_scaled(x.p, select(-x.ng, x.ng, dot(w, x.ng) > 0.0), params.offset_scale);
 }
 
 /// One light-technique sample: choose a light, sample it, test visibility, weight against the
@@ -90,7 +90,11 @@ fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f
         let to_y = c.x.p + ls.wi * ls.dist - o;
         let len = length(to_y);
         shadow_dir = to_y / len;
-        t_max = len * (1.0 - 1e-5);
+        // Stop short of y by more than y's own rounding error (~2^-23·|y| per coordinate), which a relative
+        // 1e-5 of a short shadow ray far from the origin is not.
+        let y_err = 64.0 * 1.2e-7 * (max(max(abs(c.x.p.x), abs(c.x.p.y)), abs(c.x.p.z)) + len);
+        t_max = len - max(len * 1e-5, y_err);
+        if (t_max <= 0.0) { return vec3<f32>(0.0); }
     }
     rays_traced += 1u;
     if (trace_any(o, shadow_dir, t_max)) { return vec3<f32>(0.0); }

@@ -54,12 +54,34 @@ pub struct SceneData {
     pub bvh_sah: f32,
     /// Number of delta lights (reachable by light sampling only).
     pub delta_lights: u32,
+    /// World position of the render origin: every position above is relative to it (see `render_origin`).
+    pub origin: Vec3,
+    /// Largest |coordinate| of the geometry around `origin`, clamped to [1e-30, 1]: the length scale of
+    /// ray-origin offsets near the origin (`FrameParams::offset_scale`).
+    pub offset_scale: f32,
+}
+
+/// Beyond this distance of the camera from the world origin, scenes are rendered relative to the camera.
+pub const RECENTER_DISTANCE: f32 = 1024.0;
+
+/// Where positions are measured from on the device. f32 positions 1e5 from the origin are 2^-7 apart, and
+/// ray-origin offsets (256 ULPs) grow to 2 units there, jumping through the walls of a 2-unit Cornell box.
+/// Subtracting the camera position (exact for f32 values within a factor 2 of each other, Sterbenz) keeps
+/// what the camera sees at small magnitudes. Scenes near the origin keep world coordinates unchanged.
+pub fn render_origin(scene: &Scene) -> Vec3 {
+    let c = scene.camera.position;
+    if c.is_finite() && c.abs().max_element() > RECENTER_DISTANCE {
+        c
+    } else {
+        Vec3::ZERO
+    }
 }
 
 impl SceneData {
     /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device.
     pub fn build(scene: &Scene) -> SceneData {
-        let mut d = SceneData::default();
+        let mut d = SceneData { origin: render_origin(scene), ..SceneData::default() };
+        let o = d.origin;
         d.materials = scene.materials.iter().map(gpu_material).collect();
         if d.materials.is_empty() {
             d.materials.push(gpu_material(&Default::default()));
@@ -68,7 +90,7 @@ impl SceneData {
         let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
         for mesh in &scene.meshes {
             for t in &mesh.indices {
-                let p = t.map(|i| mesh.positions[i as usize]);
+                let p = t.map(|i| mesh.positions[i as usize] - o);
                 let n = t.map(|i| mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO));
                 let uv = t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default());
                 tris.push(p);
@@ -91,13 +113,27 @@ impl SceneData {
         d.spheres = scene
             .spheres
             .iter()
-            .map(|s| GpuSphere { center: s.center.into(), radius: s.radius, material: mat_index(s.material), light: INVALID, ..Default::default() })
+            .map(|s| GpuSphere { center: (s.center - o).into(), radius: s.radius, material: mat_index(s.material), light: INVALID, ..Default::default() })
             .collect();
         d.quads = scene
             .quads
             .iter()
-            .map(|q| GpuQuad { corner: q.corner.into(), edge_u: q.edge_u.into(), edge_v: q.edge_v.into(), material: mat_index(q.material), light: INVALID, ..Default::default() })
+            .map(|q| GpuQuad { corner: (q.corner - o).into(), edge_u: q.edge_u.into(), edge_v: q.edge_v.into(), material: mat_index(q.material), light: INVALID, ..Default::default() })
             .collect();
+        let mut extent = 0.0f32;
+        for v in tris.iter().flatten() {
+            extent = extent.max(v.abs().max_element());
+        }
+        for s in &scene.spheres {
+            extent = extent.max((s.center - o).abs().max_element() + s.radius);
+        }
+        for q in &scene.quads {
+            let c = q.corner - o;
+            for p in [c, c + q.edge_u, c + q.edge_v, c + q.edge_u + q.edge_v] {
+                extent = extent.max(p.abs().max_element());
+            }
+        }
+        d.offset_scale = if extent.is_finite() && extent > 0.0 { extent.clamp(1e-30, 1.0) } else { 1.0 };
         let bvh = bvh::build(&tris, &d.spheres, &d.quads);
         d.bvh_seconds = bvh.build_seconds;
         d.bvh_sah = bvh.sah_cost;
@@ -242,14 +278,14 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     for l in &scene.punctual_lights {
         let (g, p) = match *l {
             PunctualLight::Point { position, intensity } => (
-                GpuLight { kind: LIGHT_POINT, position: position.into(), radiance: intensity.into(), ..Default::default() },
+                GpuLight { kind: LIGHT_POINT, position: (position - d.origin).into(), radiance: intensity.into(), ..Default::default() },
                 4.0 * PI * luminance(intensity.into()),
             ),
             PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } => {
                 let (ci, co) = (inner_cone.cos(), outer_cone.cos());
                 let g = GpuLight {
                     kind: LIGHT_SPOT,
-                    position: position.into(),
+                    position: (position - d.origin).into(),
                     direction: direction.normalize_or(Vec3::NEG_Z).into(),
                     radiance: intensity.into(),
                     cos_inner: ci.max(co + 1e-6).min(1.0),
@@ -316,35 +352,49 @@ pub const BINDING_NAMES: [&str; 13] = [
     "lights", "light alias table", "texture table", "texels", "environment texels", "environment alias table",
 ];
 
+/// Bytes of each group-0 buffer of `data`, in binding order (see [`BINDING_NAMES`]).
+pub fn binding_sizes(data: &SceneData) -> [u64; 13] {
+    fn bytes<T>(v: &[T]) -> u64 {
+        std::mem::size_of_val(v) as u64
+    }
+    [
+        bytes(&data.bvh_nodes),
+        bytes(&data.prim_refs),
+        bytes(&data.tri_verts),
+        bytes(&data.spheres),
+        bytes(&data.quads),
+        bytes(&data.tri_shading),
+        bytes(&data.materials),
+        bytes(&data.lights),
+        bytes(&data.light_alias),
+        bytes(&data.tex_info),
+        bytes(&data.tex_texels),
+        bytes(&data.env_texels),
+        bytes(&data.env_alias),
+    ]
+}
+
+/// Checks every group-0 buffer against a device's storage-buffer binding limit (bytes). The error names the
+/// buffer, its size and the limit, so that the user knows what to shrink.
+pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), String> {
+    let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+    for (name, size) in BINDING_NAMES.iter().zip(binding_sizes(data)) {
+        if size > limit {
+            return Err(format!(
+                "the scene is too large for this device: its {name} need {:.1} MiB ({size} bytes), more than the device's max_storage_buffer_binding_size of {} MiB ({limit} bytes)",
+                mib(size),
+                limit >> 20,
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
     /// larger than the device's storage-buffer binding limit.
     pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, String> {
-        let sizes = [
-            data.bvh_nodes.len() * 64,
-            data.prim_refs.len() * 4,
-            data.tri_verts.len() * 16,
-            data.spheres.len() * 32,
-            data.quads.len() * 48,
-            data.tri_shading.len() * 80,
-            data.materials.len() * 144,
-            data.lights.len() * 64,
-            data.light_alias.len() * 8,
-            data.tex_info.len() * 32,
-            data.tex_texels.len() * 4,
-            data.env_texels.len() * 16,
-            data.env_alias.len() * 8,
-        ];
-        let limit = ctx.max_storage_binding();
-        for (name, size) in BINDING_NAMES.iter().zip(sizes) {
-            if size as u64 > limit {
-                return Err(format!(
-                    "the scene is too large for this device: its {name} need {} MiB, but the device's max_storage_buffer_binding_size is {} MiB",
-                    size >> 20,
-                    limit >> 20
-                ));
-            }
-        }
+        check_binding_sizes(&data, ctx.max_storage_binding())?;
         let u = wgpu::BufferUsages::empty();
         let buffers = vec![
             ctx.storage_buffer("bvh_nodes", &data.bvh_nodes, u),

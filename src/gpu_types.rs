@@ -181,6 +181,12 @@ pub struct GpuFrameParams {
     pub row_offset: u32,
     /// Rows rendered from `row_offset`.
     pub row_count: u32,
+    /// Length scale of the scene around the render origin (≤ 1): ray-origin offsets near the origin are
+    /// proportional to it, so tiny scenes do not jump out of themselves.
+    pub offset_scale: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

@@ -24,3 +24,4 @@ pub mod bench;
 pub mod reference;
 pub mod sampler_figure;
 pub mod figure;
+pub mod stress;

@@ -38,6 +38,13 @@ enum Command {
     View(mislab::viewer::ViewArgs),
     /// Reproduce a lecture figure: veach (light / BSDF / balance / power), area-vs-cosine, samplers.
     Figure(mislab::figure::FigureArgs),
+    /// Run the numerical stress suite (extreme scales, angles, lights, degenerate geometry, broken
+    /// environment maps, extreme sample statistics) and print a table; exit 1 if any case fails.
+    Stress {
+        /// Only the cases whose name or group contains this text.
+        #[arg(long)]
+        filter: Option<String>,
+    },
     /// Print the Vulkan adapters, the chosen one and its limits; with a scene, its statistics.
     Info {
         /// A scene file or built-in name.
@@ -196,6 +203,7 @@ fn main() -> ExitCode {
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
         Command::Reference(args) => mislab::reference::run(&args).map(|_| 0).map_err(bad),
         Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
+        Command::Stress { filter } => stress(filter.as_deref()),
         Command::Figure(args) => mislab::figure::run(&args).map(|_| 0).map_err(bad),
     };
     match result {
@@ -242,6 +250,19 @@ fn unreachable_light_warning(data: &SceneData, s: &Settings) -> Option<String> {
             s.strategy, data.delta_lights
         )
     })
+}
+
+fn stress(filter: Option<&str>) -> Result<u8, Failure> {
+    let ctx = gpu_context()?;
+    eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
+    let outcomes = mislab::stress::run(&ctx, filter, |o| {
+        eprintln!("{} {:<12} {:<50} NaN/Inf {:>3}  {}", if o.pass { "pass" } else { "FAIL" }, o.group, o.name, o.nonfinite, o.detail);
+    })
+    .map_err(bad)?;
+    println!("{}", mislab::stress::table(&outcomes));
+    let failed = outcomes.iter().filter(|o| !o.pass).count();
+    println!("{} cases, {} passed, {} failed, {} NaN/Inf samples in all", outcomes.len(), outcomes.len() - failed, failed, outcomes.iter().map(|o| o.nonfinite).sum::<u64>());
+    Ok(if failed == 0 { 0 } else { 1 })
 }
 
 fn render(args: RenderArgs) -> Result<u8, Failure> {

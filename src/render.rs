@@ -59,6 +59,9 @@ pub struct Renderer {
     pub samples: u32,
     /// Target count of the fixed-count samplers (`FrameParams::sampler_spp`; see `samplers::check_spp`).
     pub sampler_spp: u32,
+    /// Samples per pixel per dispatch instead of `max_dispatch_spp`'s safe default: only for scenes so simple
+    /// that a sample's loops are short (check the film's sample counts: the driver drops what its budget cuts).
+    pub dispatch_spp: Option<u32>,
     /// Non-finite samples since the last reset (device counter, summed on the host).
     pub nonfinite_total: u64,
     /// Rays traced since the last reset.
@@ -69,6 +72,9 @@ pub struct Renderer {
     env_scale: f32,
     env_rotation: f32,
     num_lights: u32,
+    /// The scene's render origin (`SceneData::origin`): the camera is placed relative to it.
+    origin: glam::Vec3,
+    offset_scale: f32,
 }
 
 impl Renderer {
@@ -180,6 +186,7 @@ impl Renderer {
             camera,
             samples: 0,
             sampler_spp: crate::samplers::DEFAULT_SAMPLER_SPP,
+            dispatch_spp: None,
             nonfinite_total: 0,
             rays_total: 0,
             env_light: d.env_light.unwrap_or(INVALID),
@@ -188,6 +195,8 @@ impl Renderer {
             env_scale: d.env_scale,
             env_rotation: d.env_rotation,
             num_lights: d.lights.len() as u32,
+            origin: d.origin,
+            offset_scale: d.offset_scale,
         };
         r.reset();
         Ok(r)
@@ -293,7 +302,7 @@ impl Renderer {
             num_lights: self.num_lights,
             rr_depth: RR_DEPTH,
             env_light: self.env_light,
-            cam_origin: self.camera.position.into(),
+            cam_origin: (self.camera.position - self.origin).into(),
             tan_half_fov: (0.5 * self.camera.vfov).tan(),
             cam_right: right.into(),
             aspect: s.width as f32 / s.height as f32,
@@ -307,6 +316,10 @@ impl Renderer {
             sampler_spp: self.sampler_spp,
             row_offset: 0,
             row_count: s.height,
+            offset_scale: self.offset_scale,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 
@@ -363,7 +376,15 @@ impl Renderer {
     /// Most samples per pixel one dispatch may take without exhausting a driver's per-invocation loop
     /// budget (path tracing runs far more traversal steps per sample than direct lighting).
     pub fn max_dispatch_spp(&self) -> u32 {
+        if let Some(n) = self.dispatch_spp {
+            return n;
+        }
         if self.settings.mode == Mode::Path { 4 } else { 16 }
+    }
+
+    /// The pipeline built for `key`, to share with another renderer (`insert_pipeline`).
+    pub fn pipeline(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
+        self.pipelines.get(key)
     }
 
     /// Adds the device counters to the host totals and clears them (u32 on the device would overflow).

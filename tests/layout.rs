@@ -51,7 +51,8 @@ fn shared_structs_match() {
     check!(m, "FrameParams", GpuFrameParams, [width, height, sample_base, samples_per_dispatch, seed, mode, max_depth,
         strategy, light_sampling, env_sampling, light_select, heuristic, power_beta, light_samples, bsdf_samples,
         mis_kind, sampler, num_lights, rr_depth, env_light, cam_origin, tan_half_fov, cam_right, aspect, cam_up,
-        env_scale, cam_forward, env_rotation, env_constant, env_width, env_height, sampler_spp, row_offset, row_count]);
+        env_scale, cam_forward, env_rotation, env_constant, env_width, env_height, sampler_spp, row_offset, row_count,
+        offset_scale, _pad0, _pad1, _pad2]);
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
     check!(m, "BvhNode", GpuBvhNode, [lmin, l_first, lmax, l_count, rmin, r_first, rmax, r_count]);
 }
