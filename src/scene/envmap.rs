@@ -34,10 +34,52 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
         std::io::ErrorKind::NotFound => err("environment map not found".into()),
         _ => err(format!("cannot open environment map: {e}")),
     })?;
-    if file.metadata().map(|m| m.is_dir()).unwrap_or(false) {
+    let metadata = file.metadata().map_err(|e| err(format!("cannot read environment map: {e}")))?;
+    if metadata.is_dir() {
         return Err(err("is a directory, not an environment map".into()));
     }
+    if metadata.len() == 0 {
+        return Err(err("empty file (0 bytes)".into()));
+    }
+    if format == image::ImageFormat::Hdr {
+        check_hdr_header(&file, metadata.len()).map_err(err)?;
+    }
+    // Decoders can panic on corrupt data (an overflowing run-length multiplier in the Radiance decoder, for
+    // one): that is an error about this file, not a crash.
+    super::catch_quietly(|| decode(path, file, format))
+        .unwrap_or_else(|panic| Err(err(format!("corrupt {} file (the decoder failed: {panic})", name(format)))))
+}
 
+/// How much of a Radiance file is searched for the end of its header.
+const HDR_HEADER_SCAN: u64 = 64 << 10;
+
+/// A Radiance header is the signature line, attribute lines, an empty line, then the resolution line. A file
+/// that starts like one but ends before the resolution line is cut short; the decoder would report the first
+/// partial line it meets as a bad attribute or dimension instead.
+fn check_hdr_header(file: &std::fs::File, len: u64) -> Result<(), String> {
+    use std::io::{Read, Seek};
+    let unreadable = |e: std::io::Error| format!("cannot read environment map: {e}");
+    let mut head = Vec::new();
+    let mut reader = file; // `Read` and `Seek` are implemented for `&File`: the caller's handle is rewound
+    reader.take(HDR_HEADER_SCAN).read_to_end(&mut head).map_err(unreadable)?;
+    reader.rewind().map_err(unreadable)?;
+    if !head.starts_with(b"#?RADIANCE") || len > HDR_HEADER_SCAN {
+        return Ok(()); // not a Radiance file at all, or too long to be a cut header: the decoder says what is wrong
+    }
+    let complete = match head.windows(2).position(|w| w == b"\n\n") {
+        Some(end) => head[end + 2..].contains(&b'\n'),
+        None => false,
+    };
+    if complete {
+        return Ok(());
+    }
+    Err(format!(
+        "truncated or malformed header: the file ({len} bytes) ends before the empty line that closes the Radiance header and the resolution line after it"
+    ))
+}
+
+fn decode(path: &Path, file: std::fs::File, format: image::ImageFormat) -> Result<(EnvMap, Vec<String>), SceneError> {
+    let err = |message: String| SceneError::new(path, message);
     let mut reader = image::ImageReader::with_format(BufReader::new(file), format);
     // The default 512 MiB cap would refuse a legitimate 8k×4k RGBA f32 EXR; MAX_SIDE already bounds the size, so
     // allow what a MAX_SIDE×MAX_SIDE/2 RGBA f32 map needs (2 GiB) and refuse larger ones by size, with a clear message.
@@ -135,6 +177,20 @@ fn describe(e: &image::ImageError, format: image::ImageFormat) -> String {
             format!("cannot decode this DWAA/DWAB-compressed EXR ({text}); re-save it with ZIP or PIZ compression")
         }
         image::ImageError::Unsupported(_) => format!("unsupported {} variant: {text}", name(format)),
+        // The exr crate's words for a chunk or attribute that reaches past the end of the file.
+        _ if format == image::ImageFormat::OpenExr && lower.contains("missing bytes") => {
+            format!("truncated or corrupt file: it refers to bytes past its end ({text})")
+        }
+        // A chunk whose scan line (or tile) lies outside the data window.
+        _ if format == image::ImageFormat::OpenExr && lower.contains("block position") => {
+            format!("corrupt file: a chunk lies outside the image's data window ({text})")
+        }
+        // A chunk offset so large that seeking to it fails (EINVAL).
+        _ if format == image::ImageFormat::OpenExr
+            && (lower.contains("os error 22") || lower.contains("invalid argument")) =>
+        {
+            format!("corrupt file: a chunk offset points outside the file ({text})")
+        }
         _ if format == image::ImageFormat::OpenExr && lower.contains("rgb channels") => {
             format!("no R, G, B channels found ({text}); an environment map needs an RGB(A) layer")
         }

@@ -53,11 +53,13 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
 fn load_inner(path: &Path, options: &LoadOptions) -> Res<Scene> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
     let (json_bytes, bin) = split_container(path, &bytes)?;
+    let is_glb = bytes.starts_with(b"glTF");
     let root = parse_json(json_bytes)?;
     let mut notes = Notes::default();
     check_extensions(&root, &mut notes)?;
+    check_node_graph(&root)?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(&root, bin, base)?;
+    let buffers = load_buffers(&root, bin, is_glb, base)?;
     let mut loader = Loader::new(&root, base, buffers, notes);
     loader.scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let roots = loader.scene_roots(options)?;
@@ -102,6 +104,11 @@ fn parse_glb(bytes: &[u8]) -> Res<(&[u8], Option<&[u8]>)> {
     let total = read_u32(bytes, 8) as usize;
     if total > bytes.len() {
         return Err(format!("truncated GLB: the header declares {total} bytes but the file has {}", bytes.len()));
+    }
+    if total < 12 {
+        return Err(format!(
+            "invalid GLB header: it declares a total length of {total} bytes, less than the header's own 12"
+        ));
     }
     let (mut json, mut bin, mut at) = (None, None, 12usize);
     while at < total {
@@ -163,14 +170,67 @@ fn check_extensions(root: &json::Root, notes: &mut Notes) -> Res<()> {
     Ok(())
 }
 
+/// Checks the whole node graph before anything is instantiated: every child index exists, and no node is its
+/// own ancestor. Nodes that no scene uses are checked too (a cycle makes the file invalid wherever it is), and
+/// the error shows the cycle. Iterative, so arbitrarily deep (valid) hierarchies cannot overflow the stack.
+fn check_node_graph(root: &json::Root) -> Res<()> {
+    let nodes = &root.nodes;
+    let label = |i: usize| format!("node {i}{}", quoted(&nodes[i].name));
+    // 0 = not visited, 1 = on the current path, 2 = done.
+    let mut state = vec![0u8; nodes.len()];
+    for start in 0..nodes.len() {
+        if state[start] != 0 {
+            continue;
+        }
+        // (node, index of the next child to visit)
+        let mut stack = vec![(start, 0usize)];
+        state[start] = 1;
+        while let Some(top) = stack.last_mut() {
+            let (node, next) = *top;
+            let children = nodes[node].children.as_deref().unwrap_or(&[]);
+            let Some(child) = children.get(next).map(|c| c.value()) else {
+                state[node] = 2;
+                stack.pop();
+                continue;
+            };
+            top.1 += 1;
+            if child >= nodes.len() {
+                let count = nodes.len();
+                return Err(format!("{}: child node {child} does not exist (the file has {count} nodes)", label(node)));
+            }
+            match state[child] {
+                0 => {
+                    state[child] = 1;
+                    stack.push((child, 0));
+                }
+                1 => {
+                    let from = stack.iter().position(|&(n, _)| n == child).unwrap_or(0);
+                    let path: Vec<String> =
+                        stack[from..].iter().map(|&(n, _)| n.to_string()).chain([child.to_string()]).collect();
+                    return Err(format!(
+                        "{} is its own ancestor: the node hierarchy contains a cycle (nodes {})",
+                        label(child),
+                        path.join(" → ")
+                    ));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Reads every buffer (GLB chunk, external file or data URI) and checks it against its declared byteLength.
-fn load_buffers(root: &json::Root, bin: Option<&[u8]>, base: &Path) -> Res<Vec<Vec<u8>>> {
+fn load_buffers(root: &json::Root, bin: Option<&[u8]>, is_glb: bool, base: &Path) -> Res<Vec<Vec<u8>>> {
     let mut out = Vec::with_capacity(root.buffers.len());
     for (i, buffer) in root.buffers.iter().enumerate() {
         let what = format!("buffer {i}{}", quoted(&buffer.name));
         let mut data = match (&buffer.uri, bin) {
             (Some(uri), _) => fetch_uri(base, uri).map_err(|m| format!("{what}: {m}"))?,
             (None, Some(bin)) if i == 0 => bin.to_vec(),
+            (None, None) if i == 0 && is_glb => {
+                return Err(format!("{what} has no uri, and the GLB file has no BIN chunk to hold its data"))
+            }
             (None, _) => return Err(format!("{what} has no uri (only a .glb's first buffer may omit it)")),
         };
         let declared = buffer.byte_length.0;
@@ -356,6 +416,14 @@ fn check_format(acc: &json::Accessor, usage: Usage) -> Res<(ComponentType, usize
         ));
     }
     Ok((comp, ty.multiplicity()))
+}
+
+/// Rejects absurd element counts before anything is allocated for them.
+fn check_count(acc: &json::Accessor) -> Res<()> {
+    if acc.count.0 > MAX_ELEMENTS {
+        return Err(format!("count {} exceeds the limit of {MAX_ELEMENTS} elements", acc.count.0));
+    }
+    Ok(())
 }
 
 /// A validated strided view of `count` elements: element i is `bytes[i*stride .. i*stride+elem]`.
@@ -587,6 +655,24 @@ impl<'a> Loader<'a> {
             self.notes.push(format!("{what} has no POSITION attribute and was skipped"));
             return Ok(None);
         };
+        // An accessor with neither a bufferView nor sparse values is all zeros (spec): zero positions, or indices
+        // that are all 0, make every triangle degenerate. Skip it before allocating: a few bytes of JSON can
+        // declare tens of millions of them.
+        let zero_positions = self.all_zeros(position, Usage::Position, what)?;
+        let zero_indices = match prim.indices {
+            Some(a) => self.all_zeros(a.value(), Usage::Indices, what)?,
+            None => false,
+        };
+        if zero_positions || zero_indices {
+            let (which, a) = match prim.indices {
+                Some(a) if zero_indices => ("indices", a.value()),
+                _ => ("POSITION", position),
+            };
+            self.notes.push(format!(
+                "{what}: its {which} accessor {a} has neither a bufferView nor sparse values, so it is all zeros and every triangle is degenerate; skipped"
+            ));
+            return Ok(None);
+        }
         let positions = self.read_vec3(position, Usage::Position, what)?;
         let n = positions.len();
         let normals = match attribute(Semantic::Normals) {
@@ -611,6 +697,15 @@ impl<'a> Loader<'a> {
     fn read_vec3(&self, index: usize, usage: Usage, what: &str) -> Res<Vec<Vec3>> {
         let flat = self.read(index, usage, what, to_f32)?;
         Ok(flat.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
+    }
+
+    /// Whether accessor `index` is implicitly all zeros (neither a bufferView nor sparse values), after checking
+    /// its format and count as `read` does (a missing accessor is left for `read` to report).
+    fn all_zeros(&self, index: usize, usage: Usage, what: &str) -> Res<bool> {
+        let Some(acc) = self.root.accessors.get(index) else { return Ok(false) };
+        let label = format!("accessor {index} ({} of {what})", usage.name());
+        check_format(acc, usage).and_then(|_| check_count(acc)).map_err(|m| format!("{label}: {m}"))?;
+        Ok(acc.buffer_view.is_none() && acc.sparse.is_none())
     }
 
     /// Reads an index accessor and checks every index against the vertex count.
@@ -638,9 +733,7 @@ impl<'a> Loader<'a> {
 
     fn read_checked<T: Copy + Default>(&self, acc: &json::Accessor, usage: Usage, convert: Convert<T>) -> Res<Vec<T>> {
         let (comp, n) = check_format(acc, usage)?;
-        if acc.count.0 > MAX_ELEMENTS {
-            return Err(format!("count {} exceeds the limit of {MAX_ELEMENTS} elements", acc.count.0));
-        }
+        check_count(acc)?;
         let (count, size) = (acc.count.0 as usize, comp.size());
         let mut out = Vec::new();
         match acc.buffer_view {
@@ -806,7 +899,12 @@ impl<'a> Loader<'a> {
             .get(ti)
             .ok_or_else(|| format!("{label}: texture {ti} does not exist (the file has {count} textures)"))?;
         let (wrap_s, wrap_t, nearest) = self.sampler(texture.sampler, label)?;
+        // gltf-json fills a missing (required) "source" with u32::MAX, for the texture extensions that carry
+        // their own source; we support none of those.
         let image = texture.source.value();
+        if image == u32::MAX as usize {
+            return Err(format!("{label}: texture {ti} has no source image (its \"source\" is missing)"));
+        }
         let key = (image, wrap_s as u8, wrap_t as u8, nearest, srgb);
         let id = match self.textures.get(&key) {
             Some(&id) => id,
@@ -823,7 +921,16 @@ impl<'a> Loader<'a> {
         let mut reference = TextureRef::identity(id);
         let mut texcoord = info.tex_coord;
         if let Some(t) = info.extensions.as_ref().and_then(|e| e.texture_transform.as_ref()) {
-            reference.transform = texture_transform(t.offset.0, t.rotation.0, t.scale.0);
+            let transform = texture_transform(t.offset.0, t.rotation.0, t.scale.0);
+            if transform.iter().flatten().all(|x| x.is_finite()) {
+                reference.transform = transform;
+            } else {
+                // Non-finite UVs would turn every texel lookup into NaN; the untransformed texture is the repair.
+                let (offset, rotation, scale) = (t.offset.0, t.rotation.0, t.scale.0);
+                self.notes.push(format!(
+                    "{label}: non-finite KHR_texture_transform ignored (offset {offset:?}, rotation {rotation}, scale {scale:?})"
+                ));
+            }
             texcoord = t.tex_coord.unwrap_or(texcoord);
         }
         if texcoord != 0 {

@@ -317,20 +317,48 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         return Err(SceneError::new(path, format!("no such file, and not a built-in scene (built-ins: {names})")));
     }
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match ext.as_str() {
+    let result = catch_quietly(|| match ext.as_str() {
         "gltf" | "glb" => gltf::load(path, options),
         "toml" => toml::load(path, options),
         _ => Err(SceneError::new(path, format!("unknown scene format '.{ext}' (expected .gltf, .glb or .toml)"))),
-    }));
+    });
     match result {
         Ok(r) => r,
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_else(|| "unknown panic".into());
-            Err(SceneError::new(path, format!("malformed file (the loader failed: {what})")))
-        }
+        Err(what) => Err(SceneError::new(path, format!("malformed file (the loader failed: {what})"))),
     }
+}
+
+/// Runs `f`, turning a panic into `Err(its message)` without printing it: a decoder or loader that panics on
+/// a malformed file is reported as an error about that file, not as a crash. Panics on other threads, and
+/// outside `f`, still reach the previous panic hook.
+pub(crate) fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    use std::cell::Cell;
+    use std::panic::{self, PanicHookInfo};
+    use std::sync::Arc;
+    type Hook = Box<dyn Fn(&PanicHookInfo<'_>) + Sync + Send + 'static>;
+    thread_local!(static QUIET: Cell<u32> = const { Cell::new(0) });
+
+    let previous: Arc<Hook> = Arc::new(panic::take_hook());
+    let shared = previous.clone();
+    panic::set_hook(Box::new(move |info| {
+        if QUIET.with(Cell::get) == 0 {
+            shared(info)
+        }
+    }));
+    QUIET.with(|q| q.set(q.get() + 1));
+    let result = panic::catch_unwind(panic::AssertUnwindSafe(f));
+    QUIET.with(|q| q.set(q.get() - 1));
+    // Put the previous hook back (unwrapped, so repeated calls do not nest hooks).
+    drop(panic::take_hook());
+    match Arc::try_unwrap(previous) {
+        Ok(hook) => panic::set_hook(hook),
+        Err(shared) => panic::set_hook(Box::new(move |info| shared(info))),
+    }
+    result.map_err(|panic| {
+        panic
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_else(|| "unknown panic".into())
+    })
 }

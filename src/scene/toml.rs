@@ -86,10 +86,10 @@ struct FileDef {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CameraDef {
-    position: [f32; 3],
-    look_at: Option<[f32; 3]>,
-    forward: Option<[f32; 3]>,
-    up: Option<[f32; 3]>,
+    position: V3,
+    look_at: Option<V3>,
+    forward: Option<V3>,
+    up: Option<V3>,
     vfov: Option<f32>,
 }
 
@@ -111,7 +111,7 @@ struct MaterialDef {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SphereDef {
-    center: [f32; 3],
+    center: V3,
     radius: f32,
     material: String,
 }
@@ -119,19 +119,19 @@ struct SphereDef {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct QuadDef {
-    corner: [f32; 3],
-    edge_u: [f32; 3],
-    edge_v: [f32; 3],
+    corner: V3,
+    edge_u: V3,
+    edge_v: V3,
     material: String,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RectangleDef {
-    center: [f32; 3],
-    normal: [f32; 3],
+    center: V3,
+    normal: V3,
     size: Splat<2>,
-    u_axis: Option<[f32; 3]>,
+    u_axis: Option<V3>,
     material: String,
 }
 
@@ -139,9 +139,9 @@ struct RectangleDef {
 #[serde(deny_unknown_fields)]
 struct MeshDef {
     name: Option<String>,
-    positions: Vec<[f32; 3]>,
-    indices: Vec<[u32; 3]>,
-    normals: Option<Vec<[f32; 3]>>,
+    positions: Vec<V3>,
+    indices: Vec<Arr<u32, 3>>,
+    normals: Option<Vec<V3>>,
     material: String,
 }
 
@@ -150,8 +150,8 @@ struct MeshDef {
 struct LightDef {
     #[serde(rename = "type")]
     kind: String,
-    position: Option<[f32; 3]>,
-    direction: Option<[f32; 3]>,
+    position: Option<V3>,
+    direction: Option<V3>,
     intensity: Option<Splat<3>>,
     irradiance: Option<Splat<3>>,
     inner_cone: Option<f32>,
@@ -171,7 +171,7 @@ struct EnvironmentDef {
 #[serde(deny_unknown_fields)]
 struct IncludeDef {
     gltf: String,
-    translate: Option<[f32; 3]>,
+    translate: Option<V3>,
     rotate: Option<RotateDef>,
     scale: Option<Splat<3>>,
     scene: Option<usize>,
@@ -181,9 +181,50 @@ struct IncludeDef {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RotateDef {
-    axis: Option<[f32; 3]>,
+    axis: Option<V3>,
     angle: Option<f32>,
-    euler: Option<[f32; 3]>,
+    euler: Option<V3>,
+}
+
+/// A point or vector: exactly three numbers.
+type V3 = Arr<f32, 3>;
+
+/// An array of exactly N values. (The toml deserializer does not reject extra elements for Rust's fixed-size
+/// arrays: with `[f32; 3]`, `position = [0, 1, 5, 2]` would load as `[0, 1, 5]` without a word.)
+#[derive(Clone, Copy)]
+struct Arr<T, const N: usize>([T; N]);
+
+impl<T, const N: usize> From<Arr<T, N>> for [T; N] {
+    fn from(a: Arr<T, N>) -> [T; N] {
+        a.0
+    }
+}
+
+impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Deserialize<'de> for Arr<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T, const N: usize>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Visitor<'de> for V<T, N> {
+            type Value = Arr<T, N>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "an array of {N} numbers")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut out = [T::default(); N];
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                let mut extra = 0;
+                while seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    extra += 1;
+                }
+                if extra > 0 {
+                    return Err(de::Error::invalid_length(N + extra, &self));
+                }
+                Ok(Arr(out))
+            }
+        }
+        d.deserialize_seq(V::<T, N>(std::marker::PhantomData))
+    }
 }
 
 /// A number (repeated N times) or an array of N numbers: `0.5` or `[0.5, 0.4, 0.3]`.
@@ -310,14 +351,15 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
             .map(|p| finite_vec(*p))
             .collect::<Option<_>>()
             .ok_or_else(|| e("positions must be finite"))?;
-        if d.indices.is_empty() {
+        let indices: Vec<[u32; 3]> = d.indices.iter().map(|t| t.0).collect();
+        if indices.is_empty() {
             return Err(e("no triangles (indices is empty)"));
         }
-        if let Some(bad) = d.indices.iter().flatten().find(|&&i| i as usize >= positions.len()) {
+        if let Some(bad) = indices.iter().flatten().find(|&&i| i as usize >= positions.len()) {
             return Err(e(&format!("index {bad} is out of range ({} positions)", positions.len())));
         }
         let normals = match &d.normals {
-            None => vertex_normals(&positions, &d.indices),
+            None => vertex_normals(&positions, &indices),
             Some(n) if n.len() != positions.len() => {
                 return Err(e(&format!("{} normals for {} positions", n.len(), positions.len())));
             }
@@ -329,7 +371,7 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
         };
         let material = lookup(&e, &d.material)?;
         let name = d.name.clone().unwrap_or_else(|| format!("mesh{}", i + 1));
-        scene.meshes.push(Mesh { name, positions, normals, uvs: Vec::new(), indices: d.indices.clone(), material });
+        scene.meshes.push(Mesh { name, positions, normals, uvs: Vec::new(), indices, material });
     }
 
     for (i, l) in file.light.iter().enumerate() {
@@ -349,8 +391,8 @@ fn build(ctx: &Ctx, file: FileDef, name: String, options: &LoadOptions) -> Resul
     Ok(scene)
 }
 
-fn finite_vec(v: [f32; 3]) -> Option<Vec3> {
-    let v = Vec3::from(v);
+fn finite_vec(v: impl Into<[f32; 3]>) -> Option<Vec3> {
+    let v = Vec3::from(v.into());
     v.is_finite().then_some(v)
 }
 
@@ -367,7 +409,7 @@ fn camera(ctx: &Ctx, c: &Spanned<CameraDef>) -> Result<Camera, SceneError> {
     let forward = forward
         .and_then(Vec3::try_normalize)
         .ok_or_else(|| e("the viewing direction is zero or not finite (look_at equals position?)"))?;
-    let up = finite_vec(d.up.unwrap_or([0.0, 1.0, 0.0]))
+    let up = finite_vec(d.up.map_or([0.0, 1.0, 0.0], |u| u.0))
         .and_then(Vec3::try_normalize)
         .ok_or_else(|| e("up must be a finite non-zero vector"))?;
     if forward.cross(up).length_squared() < 1e-8 {
@@ -567,7 +609,7 @@ fn include(
     let e = |m: &str| ctx.err(inc, format!("[[include]] {} ('{}'): {m}", i + 1, d.gltf));
 
     // Transform: scale, then rotate, then translate.
-    let translate = finite_vec(d.translate.unwrap_or([0.0; 3])).ok_or_else(|| e("translate must be finite"))?;
+    let translate = finite_vec(d.translate.map_or([0.0; 3], |t| t.0)).ok_or_else(|| e("translate must be finite"))?;
     let scale = Vec3::from(d.scale.map(|s| s.0).unwrap_or([1.0; 3]));
     if !scale.is_finite() || scale.abs().min_element() < 1e-12 {
         return Err(e("scale must be finite and non-zero (a negative value mirrors)"));
