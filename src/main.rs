@@ -232,11 +232,16 @@ fn load_scene(args: &SceneArgs) -> Result<scene::Scene, Failure> {
         scene.warnings.extend(warnings);
         scene.environment = Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
     }
-    if !scene.has_lights() {
+    let geometry = scene.triangle_count() + scene.spheres.len() + scene.quads.len();
+    if !scene.has_lights() && geometry > 0 {
         scene.warnings.push("the scene has no lights and no environment: the image will be black".into());
     }
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", args.scene);
+    }
+    if geometry == 0 && !scene.has_lights() {
+        // Nothing at all to render: an empty or broken file, not a black image.
+        return Err(bad(format!("{}: the scene is empty: no geometry, no lights and no environment", args.scene)));
     }
     Ok(scene)
 }

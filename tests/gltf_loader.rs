@@ -515,7 +515,7 @@ fn robustness_corpus() {
     // (file name, Err substring or None for Ok, substring of a warning when Ok).
     let table: &[(&str, Option<&str>, &str)] = &[
         ("BoxBadNormals.glb", None, "normal"),
-        ("BoxWithInfinites.glb", None, "non-finite"),
+        ("BoxWithInfinites.glb", Some("non-finite vertex position"), ""),
         ("IndexOutOfRange.gltf", Some("index 255 at position 0 is out of range"), ""),
         ("AllIndicesOutOfRange.gltf", Some("out of range (the primitive has 24 vertices)"), ""),
         ("texcoord_crash.gltf", None, "no TEXCOORD_0"),
@@ -554,10 +554,10 @@ fn repaired_content_of_the_robustness_files() {
     let bad_normals = load_ok(&format!("{TESTDATA}/robustness/assimp/BoxBadNormals-glTF-Binary/BoxBadNormals.glb"));
     assert_eq!(bad_normals.triangle_count(), 12);
     assert_mesh_sane(&bad_normals.meshes[0], Path::new("BoxBadNormals"));
-    // Every position has an infinite x: all 12 triangles are dropped, leaving an empty but valid scene.
-    let infinites = load_ok(&format!("{TESTDATA}/robustness/assimp/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb"));
-    assert_eq!(infinites.triangle_count(), 0);
-    assert!(infinites.warnings.iter().any(|w| w.starts_with("12 dropped triangle")), "{:?}", infinites.warnings);
+    // Every position has an infinite x: corrupt data is refused, naming the vertex.
+    let infinites = load_no_panic(Path::new(&format!("{TESTDATA}/robustness/assimp/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb")));
+    let e = infinites.expect_err("a NaN/Inf position must be an error");
+    assert!(e.contains("BoxWithInfinites.glb") && e.contains("non-finite vertex position: vertex 0"), "{e}");
 }
 
 #[test]
@@ -793,23 +793,31 @@ fn mirrored_node_keeps_normals_outward() {
 }
 
 #[test]
-fn non_finite_vertices_dropped_and_normals_generated() {
+fn non_finite_vertices_are_refused_when_used_and_normals_generated() {
     let dir = scratch("nan");
     let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [f32::NAN, 0.0, 0.0]];
-    let bytes = triangle_buffer(&positions, &[0, 1, 2, 1, 3, 2]);
-    let mut v = triangle_gltf();
-    v["buffers"][0] = parse(&format!(r#"{{"byteLength": {}}}"#, bytes.len()));
-    v["buffers"][0]["uri"] = b64(&bytes).into();
-    v["bufferViews"] = parse(r#"[{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}]"#);
-    v["accessors"][0]["count"] = 4.into();
-    v["accessors"][1]["count"] = 6.into();
-    v["meshes"][0]["primitives"][0]["attributes"] = parse(r#"{"POSITION": 0}"#);
-    let s = load_no_panic(&write_json(&dir, "nan.gltf", &v)).unwrap();
+    let gltf_with = |indices: &[u16]| {
+        let bytes = triangle_buffer(&positions, indices);
+        let mut v = triangle_gltf();
+        v["buffers"][0] = parse(&format!(r#"{{"byteLength": {}}}"#, bytes.len()));
+        v["buffers"][0]["uri"] = b64(&bytes).into();
+        let ib = 2 * indices.len();
+        v["bufferViews"] = parse(&format!(r#"[{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": {ib}}}]"#));
+        v["accessors"][0]["count"] = 4.into();
+        v["accessors"][1]["count"] = indices.len().into();
+        v["meshes"][0]["primitives"][0]["attributes"] = parse(r#"{"POSITION": 0}"#);
+        v
+    };
+    // A triangle uses the NaN vertex: corrupt data, refused with the vertex named.
+    let e = load_no_panic(&write_json(&dir, "nan.gltf", &gltf_with(&[0, 1, 2, 1, 3, 2]))).expect_err("NaN position in use");
+    assert!(e.contains("nan.gltf") && e.contains("non-finite vertex position: vertex 3 is (NaN, 0, 0)"), "{e}");
+    // No triangle uses it: nothing to refuse; the normals are generated from the geometry.
+    let s = load_no_panic(&write_json(&dir, "unused.gltf", &gltf_with(&[0, 1, 2]))).unwrap();
     let m = &s.meshes[0];
     assert_eq!(m.indices.len(), 1);
-    assert_eq!(m.positions.len(), 3, "the unused non-finite vertex is removed");
-    assert!(m.normals.iter().all(|n| close3(*n, Vec3::Z, 1e-6)));
-    assert!(s.warnings.iter().any(|w| w.contains("1 dropped triangle")), "{:?}", s.warnings);
+    for t in &m.indices {
+        assert!(t.iter().all(|&i| m.positions[i as usize].is_finite() && close3(m.normals[i as usize], Vec3::Z, 1e-6)));
+    }
 }
 
 #[test]

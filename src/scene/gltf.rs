@@ -644,6 +644,20 @@ impl<'a> Loader<'a> {
             self.notes
                 .push(format!("{what} has a textured material but no TEXCOORD_0; its textures are sampled at (0, 0)"));
         }
+        // A NaN or Inf position is corrupt data, not something to guess around: refuse the file, naming the vertex.
+        let used = triangles.iter().flatten().map(|&i| (i, world.transform_point3(geometry.positions[i as usize])));
+        let bad: Vec<(u32, Vec3)> = used.filter(|(_, p)| !p.is_finite()).collect();
+        if let Some(&(i, p)) = bad.first() {
+            let file_value = geometry.positions[i as usize];
+            let (source, p) = if file_value.is_finite() { ("its node transform makes it non-finite", p) } else { ("POSITION holds NaN/Inf", file_value) };
+            return Err(format!(
+                "{what}: non-finite vertex position: vertex {i} is ({}, {}, {}) ({source}; {} use(s) by triangles in all)",
+                p.x,
+                p.y,
+                p.z,
+                bad.len()
+            ));
+        }
         let mesh = Mesh { name: name.to_string(), material, ..Default::default() };
         Ok(build_mesh(mesh, geometry, triangles, world, &mut self.notes))
     }

@@ -505,14 +505,13 @@ g("node-index-string", set_(["nodes", 0, "mesh"], "0"), "error", "invalid glTF J
 # Scenes.
 g("scene-default-missing", set_(["scene"], 3), "error", "scene 3 is the default scene, but the file has 1 scene(s)")
 g("scene-requested-missing", lambda d: None, "error", "scene 4 was requested, but the file has 1 scene(s)", args="--gltf-scene 4")
-g("scene-empty", set_(["scenes", 0, "nodes"], []), "warning", "the scene contains nothing to render")
-g("scene-none-and-no-nodes", many(lambda d: d.pop("scenes"), lambda d: d.pop("scene"), set_(["nodes"], [])), "warning",
-  "the file has no scenes")
+g("scene-empty", set_(["scenes", 0, "nodes"], []), "error", "the scene is empty: no geometry, no lights and no environment")
+g("scene-none-and-no-nodes", many(lambda d: d.pop("scenes"), lambda d: d.pop("scene"), set_(["nodes"], [])), "error", "the scene is empty: no geometry, no lights and no environment")
 # Meshes, materials, modes.
 g("mesh-missing-material", set_(PRIM + ["material"], 3), "error", "material 3 does not exist (the file has 1 materials)")
 g("mesh-invalid-mode", set_(PRIM + ["mode"], 9), "error", "mesh 'Tri' primitive 0: invalid primitive mode")
-g("mesh-points-only", set_(PRIM + ["mode"], 0), "warning", "skipped point/line primitive(s)")
-g("mesh-no-position", set_(ATTR, {"NORMAL": 2}), "warning", "has no POSITION attribute and was skipped")
+g("mesh-points-only", set_(PRIM + ["mode"], 0), "error", "the scene is empty: no geometry, no lights and no environment")
+g("mesh-no-position", set_(ATTR, {"NORMAL": 2}), "error", "the scene is empty: no geometry, no lights and no environment")
 g("mesh-primitives-missing", lambda d: d["meshes"][0].pop("primitives"), "error", "invalid glTF JSON")
 # Extensions.
 for ext in ["EXT_meshopt_compression", "KHR_draco_mesh_compression", "KHR_mesh_quantization", "KHR_texture_basisu",
@@ -531,9 +530,9 @@ g("asset-version-number", set_(["asset", "version"], 2.0), "error", "invalid glT
 NAN_POS = tri_buffer(positions=[(0, 0, 0), (1, 0, 0), (0, 1, 0), (float("nan"), 0, 0)], indices=(0, 1, 2, 1, 3, 2))
 g("positions-nan-partial", lambda d: d.update(edited(tri(buffer=NAN_POS), many(
     set_(["accessors", 0, "count"], 4), set_(["accessors", 1, "count"], 6), set_(["bufferViews", 1, "byteLength"], 12),
-    set_(["accessors", 2, "count"], 4)))), "warning", "1 dropped triangle(s) that use non-finite (NaN/Inf) vertex positions")
+    set_(["accessors", 2, "count"], 4)))), "error", "non-finite vertex position: vertex 3 is (NaN, 0, 0) (POSITION holds NaN/Inf")
 INF_POS = tri_buffer(positions=[(float("inf"), 0, 0), (1, 0, 0), (0, float("-inf"), 0)])
-g("positions-inf-all", lambda d: d.update(tri(buffer=INF_POS)), "warning", "dropped triangle(s) that use non-finite (NaN/Inf) vertex positions")
+g("positions-inf-all", lambda d: d.update(tri(buffer=INF_POS)), "error", "non-finite vertex position: vertex 0 is (inf, 0, 0)")
 NAN_NORMALS = tri_buffer(normals=[(float("nan"), 0, 1), (0, 0, 0), (0, 0, 1)])
 g("normals-nan", lambda d: d.update(tri(buffer=NAN_NORMALS)), "warning", "zero or non-finite vertex normal(s) regenerated")
 g("camera-yfov-inf", many(set_(["cameras"], [{"type": "perspective", "perspective": {"yfov": 1e39, "znear": 0.1}}]),
@@ -542,10 +541,10 @@ g("material-emission-inf", set_(["materials", 0, "emissiveFactor"], [1e39, 1, 1]
   "non-finite factors replaced by the glTF defaults")
 g("no-lights", lambda d: d.update(tri(emissive=False)), "warning", "no lights and no environment")
 # Accessors without a bufferView are all zeros: 60 million zero positions (or indices) from a few bytes of JSON.
-g("positions-implicit-zeros", set_(["accessors", 0], {"componentType": 5126, "count": 60000000, "type": "VEC3"}), "warning",
-  "its POSITION accessor 0 has neither a bufferView nor sparse values, so it is all zeros")
-g("indices-implicit-zeros", set_(["accessors", 1], {"componentType": 5125, "count": 60000000, "type": "SCALAR"}), "warning",
-  "its indices accessor 1 has neither a bufferView nor sparse values")
+g("positions-implicit-zeros", set_(["accessors", 0], {"componentType": 5126, "count": 60000000, "type": "VEC3"}),
+  "error", "the scene is empty: no geometry, no lights and no environment")
+g("indices-implicit-zeros", set_(["accessors", 1], {"componentType": 5125, "count": 60000000, "type": "SCALAR"}),
+  "error", "the scene is empty: no geometry, no lights and no environment")
 # Deeply nested (but valid) JSON loads: no recursion limit trips and the stack does not overflow.
 case("gltf/json-nested-deeply.gltf", to_json(tri())[:-1] + ',"extras":' + "[" * 3000 + "]" * 3000 + "}", "ok")
 
@@ -655,10 +654,10 @@ case("glb/stride-too-small.glb", glb_with(edited(cube_doc(), set_(["bufferViews"
      "accessor 0 (POSITION of mesh 'Cube' primitive 0): byteStride 8 is smaller than the element size 12")
 case("glb/index-57.glb", glb_with(bin_data=patch(CUBE_BIN, CUBE_INDEX_AT + 2 * 5, struct.pack("<H", 57))), "error",
      "accessor 2 (indices of mesh 'Cube' primitive 0): index 57 at position 5 is out of range (the primitive has 24 vertices)")
-case("glb/position-nan.glb", glb_with(bin_data=patch(CUBE_BIN, 12 * 4 + 4, struct.pack("<f", float("nan")))), "warning",
-     "2 dropped triangle(s) that use non-finite (NaN/Inf) vertex positions")
-case("glb/position-inf.glb", glb_with(bin_data=patch(CUBE_BIN, 0, struct.pack("<f", float("inf")))), "warning",
-     "dropped triangle(s) that use non-finite (NaN/Inf) vertex positions")
+case("glb/position-nan.glb", glb_with(bin_data=patch(CUBE_BIN, 12 * 4 + 4, struct.pack("<f", float("nan")))), "error",
+     "non-finite vertex position")
+case("glb/position-inf.glb", glb_with(bin_data=patch(CUBE_BIN, 0, struct.pack("<f", float("inf")))), "error",
+     "non-finite vertex position")
 case("glb/buffer-uri-missing-file.glb", glb_with(edited(cube_doc(), set_(["buffers", 0, "uri"], "cube.bin"))), "error",
      "buffer 0: cannot read")
 case("glb/version-1-json.glb", glb_with(edited(cube_doc(), set_(["asset", "version"], "1.0"))), "error",
@@ -858,7 +857,7 @@ tm("include-translate-inf", LIT + INC + "translate = [0, inf, 0]\n", "error", "t
 tm("include-scene-missing", LIT + INC + "scene = 5\n", "error", "scene 5 was requested, but the file has 1 scene(s)")
 tm("include-unknown-key", LIT + '[[include]]\nfile = "../aux/valid.gltf"\n', "error", "unknown field `file`")
 # Valid but dark.
-tm("empty", "", "warning", "no lights and no environment")
+tm("empty", "", "error", "the scene is empty: no geometry, no lights and no environment")
 tm("no-lights", LIT.replace("[materials.lamp]\ntype = \"emitter\"\nemission = 5\n", "").replace(
     '[[quad]]\ncorner = [-0.5, 3, -0.5]\nedge_u = [1, 0, 0]\nedge_v = [0, 0, 1]\nmaterial = "lamp"\n', ""),
    "warning", "the scene has no lights and no environment: the image will be black")
