@@ -206,13 +206,16 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
 /// distance; a leaf child is intersected in its parent's step, an interior far child is pushed with its entry
 /// distance and skipped on pop if a closer hit has been found since. Each step consumes one interior node and
 /// every node is visited at most once, so the node count bounds the loop.
-fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool) -> Hit {
+fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var hit = Hit(t_max, INVALID, 0.0, 0.0);
     // NaN/Inf rays, a zero direction or a NaN or non-positive t_max can hit nothing.
     if any_nonfinite3(o) || any_nonfinite3(d) || all(d == vec3<f32>(0.0)) || !(t_max > 0.0) {
         return hit;
     }
     let r = trace_ray_setup(o, d);
+    if FLAT_SCENE {
+        return flat_traverse(r, hit, any_hit, skip);
+    }
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;
     var sp = 0u;
@@ -247,6 +250,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool) -> Hit {
                 let n = min(count, BVH_MAX_LEAF_PRIMS);
                 for (var k = 0u; k < n; k++) {
                     let prim = prim_refs[first + k];
+                    if prim == skip { continue; }
                     let h = intersect_prim(r, prim, hit.t);
                     if h.w != 0.0 {
                         hit = Hit(h.x, prim, h.y, h.z);
@@ -281,12 +285,19 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool) -> Hit {
 /// Closest hit with t in (0, t_max). On a miss prim = INVALID and t = t_max. Triangles: (b1, b2) = barycentrics of
 /// v1, v2; quads: (s, t) along edge_u, edge_v; spheres: unused (0). Both faces of everything are hit.
 fn trace_closest(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
-    return bvh_traverse(o, d, t_max, false);
+    return bvh_traverse(o, d, t_max, false, INVALID);
 }
 
 /// Whether anything is hit with t in (0, t_max) (shadow rays); returns at the first hit found.
 fn trace_any(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
-    return bvh_traverse(o, d, t_max, true).prim != INVALID;
+    return bvh_traverse(o, d, t_max, true, INVALID).prim != INVALID;
+}
+
+/// `trace_any` that ignores primitive `skip`: a shadow ray towards a point sampled on an area light never
+/// counts that light as its own occluder (a planar or convex emitter cannot hide its own visible points, and
+/// the ill-conditioned plane crossing of a grazing ray would otherwise report one).
+fn trace_any_except(o: vec3<f32>, d: vec3<f32>, t_max: f32, skip: u32) -> bool {
+    return bvh_traverse(o, d, t_max, true, skip).prim != INVALID;
 }
 
 /// Spawn point for a ray leaving a surface at p, offset along the geometric normal `ng` (unit length, oriented
@@ -305,4 +316,42 @@ fn offset_ray_origin_scaled(p: vec3<f32>, ng: vec3<f32>, scale: f32) -> vec3<f32
     let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
     let p_f = p + (scale / 65536.0) * ng;
     return select(p_i, p_f, abs(p) < vec3<f32>(scale / 32.0));
+}
+
+/// Every primitive of a tiny scene, one kind per loop (no switch, so no lane runs the other kinds' tests).
+/// Degenerate primitives, which the BVH leaves out, never report a hit from their intersection routines.
+fn flat_traverse(r: TraceRay, start: Hit, any_hit: bool, skip: u32) -> Hit {
+    var hit = start;
+    if HAS_TRIANGLES {
+        for (var i = 0u; i < FLAT_TRIANGLES; i++) {
+            if make_prim(PRIM_TRIANGLE, i) == skip { continue; }
+            let h = intersect_triangle(r, tri_verts[3u * i].xyz, tri_verts[3u * i + 1u].xyz, tri_verts[3u * i + 2u].xyz, hit.t);
+            if h.w != 0.0 {
+                hit = Hit(h.x, make_prim(PRIM_TRIANGLE, i), h.y, h.z);
+                if any_hit { return hit; }
+            }
+        }
+    }
+    if HAS_SPHERES {
+        for (var i = 0u; i < FLAT_SPHERES; i++) {
+            if make_prim(PRIM_SPHERE, i) == skip { continue; }
+            let s = spheres[i];
+            let h = intersect_sphere(r.o, r.d, s.center, s.radius, hit.t);
+            if h.w != 0.0 {
+                hit = Hit(h.x, make_prim(PRIM_SPHERE, i), h.y, h.z);
+                if any_hit { return hit; }
+            }
+        }
+    }
+    if HAS_QUADS {
+        for (var i = 0u; i < FLAT_QUADS; i++) {
+            if make_prim(PRIM_QUAD, i) == skip { continue; }
+            let h = intersect_quad(r.o, r.d, quads[i], hit.t);
+            if h.w != 0.0 {
+                hit = Hit(h.x, make_prim(PRIM_QUAD, i), h.y, h.z);
+                if any_hit { return hit; }
+            }
+        }
+    }
+    return hit;
 }

@@ -245,3 +245,8 @@ override HAS_SPECULAR: bool = true;
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.
 override MANY_LIGHTS: bool = true;
+/// Scenes of a few primitives: test them one kind at a time instead of walking the BVH (features.rs).
+override FLAT_SCENE: bool = false;
+override FLAT_TRIANGLES: u32 = 0u;
+override FLAT_SPHERES: u32 = 0u;
+override FLAT_QUADS: u32 = 0u;

@@ -97,7 +97,7 @@ fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f
         if (t_max <= 0.0) { return vec3<f32>(0.0); }
     }
     rays_traced += 1u;
-    if (trace_any(o, shadow_dir, t_max)) { return vec3<f32>(0.0); }
+    if (trace_any_except(o, shadow_dir, t_max, light_prim_ref(li))) { return vec3<f32>(0.0); }
     let p_light = pmf * ls.pdf;
     var w = 1.0;
     if (mis_n_dir > 0.0 && !ls.delta) {

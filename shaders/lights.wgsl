@@ -17,6 +17,17 @@ fn no_light_sample() -> LightSample {
     return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, false);
 }
 
+/// The primitive an area light is (a primitive reference), or INVALID for delta and environment lights.
+fn light_prim_ref(i: u32) -> u32 {
+    let l = lights[i];
+    switch l.kind {
+        case LIGHT_TRIANGLE: { return make_prim(PRIM_TRIANGLE, l.prim); }
+        case LIGHT_SPHERE: { return make_prim(PRIM_SPHERE, l.prim); }
+        case LIGHT_QUAD: { return make_prim(PRIM_QUAD, l.prim); }
+        default: { return INVALID; }
+    }
+}
+
 /// Probability of choosing light `i` under the active selection scheme.
 fn light_pmf(i: u32) -> f32 {
     let l = lights[i];

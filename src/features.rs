@@ -45,7 +45,14 @@ pub struct Features {
     pub diffuse: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
+    /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads) tested one by one instead
+    /// of traversing a BVH (no stack, no divergent traversal; on lavapipe a loop over a few primitives of one
+    /// kind beats a tree walk). None = BVH.
+    pub flat: Option<(u32, u32, u32)>,
 }
+
+/// Largest primitive count rendered without a BVH (`Features::flat`).
+pub const FLAT_MAX_PRIMS: usize = 32;
 
 impl Features {
     /// Everything compiled in.
@@ -63,6 +70,7 @@ impl Features {
             specular: true,
             diffuse: true,
             many_lights: true,
+            flat: None,
         }
     }
 
@@ -87,6 +95,10 @@ impl Features {
             specular: data.materials.iter().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: data.materials.iter().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             many_lights: data.lights.len() > 1,
+            flat: {
+                let n = (data.tri_shading.len(), data.spheres.len(), data.quads.len());
+                (n.0 + n.1 + n.2 <= FLAT_MAX_PRIMS).then_some((n.0 as u32, n.1 as u32, n.2 as u32))
+            },
         }
     }
 
@@ -106,6 +118,10 @@ impl Features {
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("MANY_LIGHTS", b(self.many_lights)),
+            ("FLAT_SCENE", b(self.flat.is_some())),
+            ("FLAT_TRIANGLES", self.flat.map_or(0.0, |f| f.0 as f64)),
+            ("FLAT_SPHERES", self.flat.map_or(0.0, |f| f.1 as f64)),
+            ("FLAT_QUADS", self.flat.map_or(0.0, |f| f.2 as f64)),
         ]
     }
 
@@ -128,6 +144,9 @@ impl Features {
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("light selection", self.many_lights);
+        if let Some((t, s, q)) = self.flat {
+            v.push(format!("flat primitive loops ({t} triangles, {s} spheres, {q} quads; no BVH)"));
+        }
         v.push(format!("environment: {:?}", self.env).to_lowercase());
         v.join(", ")
     }
