@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Wall time one submission should take.
-pub const TARGET_SUBMIT_SECONDS: f64 = 0.25;
+pub const TARGET_SUBMIT_SECONDS: f64 = 1.0;
 
 /// When to stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
