@@ -24,7 +24,10 @@ fn main() {
     let rounds: u32 = env_or("MISLAB_BENCH_ROUNDS", 3);
     let size: u32 = env_or("MISLAB_BENCH_SIZE", 512);
     let ctx = GpuContext::new().expect("a Vulkan adapter (apt-get install mesa-vulkan-drivers)");
-    println!("device: {} ({:?}); {size}x{size}, {rounds} rounds of {seconds} s per pipeline, alternating", ctx.info.name, ctx.info.device_type);
+    println!(
+        "device: {} ({:?}); {size}x{size}, {rounds} rounds of {seconds} s per pipeline, alternating",
+        ctx.info.name, ctx.info.device_type
+    );
     let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata");
     let helmet = format!("{shared}/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
     let sky = format!("{shared}/env/hdr/noon_grass_1k.hdr");
@@ -34,7 +37,10 @@ fn main() {
         ("veach-mis", "veach-mis".into(), Mode::Direct, false),
         ("DamagedHelmet + noon_grass", helmet, Mode::Path, true),
     ];
-    println!("{:<28} {:>6} {:>10} {:>12} {:>7} {:>14}  features", "scene", "mode", "spec Ms/s", "generic Ms/s", "ratio", "compile s s/g");
+    println!(
+        "{:<28} {:>6} {:>10} {:>12} {:>7} {:>14}  features",
+        "scene", "mode", "spec Ms/s", "generic Ms/s", "ratio", "compile s s/g"
+    );
     let mut generic: Option<wgpu::ComputePipeline> = None;
     for (label, name, mode, env) in cases {
         let mut s = scene::load(&name, &LoadOptions::default()).expect("scene");
@@ -63,8 +69,14 @@ fn main() {
             for (k, spec) in [true, false].into_iter().enumerate() {
                 r.set_specialize(spec).expect("pipeline");
                 r.reset();
-                let stats = progressive::run(&ctx, &mut r, Budget::Time(Duration::from_secs_f64(seconds)), &AtomicBool::new(false), |_, _| {})
-                    .expect("render");
+                let stats = progressive::run(
+                    &ctx,
+                    &mut r,
+                    Budget::Time(Duration::from_secs_f64(seconds)),
+                    &AtomicBool::new(false),
+                    |_, _| {},
+                )
+                .expect("render");
                 totals[k].0 += stats.spp as f64 * (size * size) as f64;
                 totals[k].1 += stats.seconds;
             }

@@ -28,7 +28,10 @@ fn main() {
         ("area-vs-cosine", "area-vs-cosine".into(), Mode::Direct, false),
         ("DamagedHelmet + noon_grass", helmet, Mode::Path, true),
     ];
-    println!("{:<28} {:>6} {:>10} {:>10} {:>8} {:>10} {:>9} {:>9}", "scene", "mode", "tris", "BVH ms", "B/tri", "spp", "Msamp/s", "Mrays/s");
+    println!(
+        "{:<28} {:>6} {:>10} {:>10} {:>8} {:>10} {:>9} {:>9}",
+        "scene", "mode", "tris", "BVH ms", "B/tri", "spp", "Msamp/s", "Mrays/s"
+    );
     for (label, name, mode, env) in cases {
         let mut s = scene::load(&name, &LoadOptions::default()).expect("scene");
         if env {
@@ -40,8 +43,14 @@ fn main() {
         let gs = GpuScene::upload(&ctx, data).expect("upload");
         let settings = Settings { mode, ..Settings::default() };
         let mut r = Renderer::new(&ctx, &gs, s.camera.clone(), settings).expect("renderer");
-        let stats = progressive::run(&ctx, &mut r, Budget::Time(Duration::from_secs_f64(seconds)), &AtomicBool::new(false), |_, _| {})
-            .expect("render");
+        let stats = progressive::run(
+            &ctx,
+            &mut r,
+            Budget::Time(Duration::from_secs_f64(seconds)),
+            &AtomicBool::new(false),
+            |_, _| {},
+        )
+        .expect("render");
         let samples = stats.spp as f64 * 512.0 * 512.0;
         println!(
             "{:<28} {:>6} {:>10} {:>10.1} {:>8.0} {:>10} {:>9.3} {:>9.3}",

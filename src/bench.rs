@@ -410,7 +410,9 @@ impl BenchArgs {
                                 *p = dir.join(&*p);
                             }
                         }
-                        if !crate::scene::builtin::NAMES.contains(&g.scene.as_str()) && Path::new(&g.scene).is_relative() {
+                        if !crate::scene::builtin::NAMES.contains(&g.scene.as_str())
+                            && Path::new(&g.scene).is_relative()
+                        {
                             g.scene = dir.join(&g.scene).to_string_lossy().into_owned();
                         }
                         g
@@ -509,7 +511,12 @@ impl TimedRender {
         } else {
             (None, None)
         };
-        TimedRender { query_set, resolve, period_ns: ctx.queue.get_timestamp_period() as f64, dispatch_spp: dispatch_spp.max(1) }
+        TimedRender {
+            query_set,
+            resolve,
+            period_ns: ctx.queue.get_timestamp_period() as f64,
+            dispatch_spp: dispatch_spp.max(1),
+        }
     }
 
     fn read_gpu_seconds(&self, ctx: &GpuContext, pairs: u32) -> Result<f64, String> {
@@ -638,9 +645,34 @@ pub struct BenchRow {
 
 /// CSV columns, in order.
 pub const CSV_COLUMNS: &[&str] = &[
-    "group", "config", "scene", "mode", "strategy", "sampler", "heuristic", "light_sampling", "env_sampling", "light_select",
-    "mis", "width", "height", "spp", "seed", "seconds_gpu", "seconds_wall", "rmse", "relmse", "mae", "efficiency",
-    "efficiency_wall", "samples_per_second", "mrays_per_second", "rays", "compile_seconds", "warmup_seconds", "dispatch_spp",
+    "group",
+    "config",
+    "scene",
+    "mode",
+    "strategy",
+    "sampler",
+    "heuristic",
+    "light_sampling",
+    "env_sampling",
+    "light_select",
+    "mis",
+    "width",
+    "height",
+    "spp",
+    "seed",
+    "seconds_gpu",
+    "seconds_wall",
+    "rmse",
+    "relmse",
+    "mae",
+    "efficiency",
+    "efficiency_wall",
+    "samples_per_second",
+    "mrays_per_second",
+    "rays",
+    "compile_seconds",
+    "warmup_seconds",
+    "dispatch_spp",
 ];
 
 fn csv_field(s: &str) -> String {
@@ -741,7 +773,11 @@ fn summarize(rows: &[&BenchRow]) -> ConfigSummary {
         let rel: Vec<f64> = rs.iter().map(|r| r.relmse).collect();
         s.spp.push(*spp);
         s.seconds.push(mean(&rs.iter().map(|r| r.seconds_gpu).collect::<Vec<_>>()));
-        s.relmse.push([mean(&rel), rel.iter().copied().fold(f64::INFINITY, f64::min), rel.iter().copied().fold(0.0, f64::max)]);
+        s.relmse.push([
+            mean(&rel),
+            rel.iter().copied().fold(f64::INFINITY, f64::min),
+            rel.iter().copied().fold(0.0, f64::max),
+        ]);
         s.rmse.push(mean(&rs.iter().map(|r| r.rmse).collect::<Vec<_>>()));
     }
     // Efficiency of the means (not the mean of per-seed efficiencies, which one lucky seed without fireflies
@@ -795,20 +831,41 @@ fn slug(s: &str) -> String {
 }
 
 /// The group's reference: the given file, or one rendered (MIS, Sobol) and cached under `refs`.
-fn group_reference(ctx: &GpuContext, g: &BenchGroup, scene: &crate::scene::Scene, refs: &Path) -> Result<(Vec<[f32; 3]>, String), String> {
+fn group_reference(
+    ctx: &GpuContext,
+    g: &BenchGroup,
+    scene: &crate::scene::Scene,
+    refs: &Path,
+) -> Result<(Vec<[f32; 3]>, String), String> {
     if let Some(path) = &g.reference {
         let r = reference::read_exr(path)?;
         if (r.width, r.height) != (g.width, g.height) {
-            return Err(format!("{}: the reference is {}x{}, the benchmark renders {}x{}", path.display(), r.width, r.height, g.width, g.height));
+            return Err(format!(
+                "{}: the reference is {}x{}, the benchmark renders {}x{}",
+                path.display(),
+                r.width,
+                r.height,
+                g.width,
+                g.height
+            ));
         }
         return Ok((r.pixels, path.display().to_string()));
     }
-    let settings = reference::reference_settings(&Settings { width: g.width, height: g.height, mode: g.mode, max_depth: g.max_depth, ..Settings::default() });
+    let settings = reference::reference_settings(&Settings {
+        width: g.width,
+        height: g.height,
+        mode: g.mode,
+        max_depth: g.max_depth,
+        ..Settings::default()
+    });
     let key = format!(
         "{}-{}{}-{}x{}-d{}-{}spp",
         slug(Path::new(&g.scene).file_stem().and_then(|s| s.to_str()).unwrap_or(&g.scene)),
         g.mode.name(),
-        g.env.as_ref().map(|e| format!("-{}", slug(&e.file_stem().unwrap_or_default().to_string_lossy()))).unwrap_or_default(),
+        g.env
+            .as_ref()
+            .map(|e| format!("-{}", slug(&e.file_stem().unwrap_or_default().to_string_lossy())))
+            .unwrap_or_default(),
         g.width,
         g.height,
         g.max_depth,
@@ -817,7 +874,9 @@ fn group_reference(ctx: &GpuContext, g: &BenchGroup, scene: &crate::scene::Scene
     let path = refs.join(format!("{key}.exr"));
     if path.exists() {
         if let Ok(r) = reference::read_exr(&path) {
-            if (r.width, r.height) == (g.width, g.height) && r.attributes.get("spp").map(|s| s.as_str()) == Some(g.reference_spp.to_string().as_str()) {
+            if (r.width, r.height) == (g.width, g.height)
+                && r.attributes.get("spp").map(|s| s.as_str()) == Some(g.reference_spp.to_string().as_str())
+            {
                 eprintln!("reference: reusing {}", path.display());
                 return Ok((r.pixels, path.display().to_string()));
             }
@@ -826,7 +885,13 @@ fn group_reference(ctx: &GpuContext, g: &BenchGroup, scene: &crate::scene::Scene
     std::fs::create_dir_all(refs).map_err(|e| format!("{}: {e}", refs.display()))?;
     eprintln!("reference: rendering {} spp of {} ({}) ...", g.reference_spp, g.scene, g.mode.name());
     let t = Instant::now();
-    let (film, stats) = reference::render_reference(ctx, scene, &settings, crate::progressive::Budget::Samples(g.reference_spp), g.dispatch_spp)?;
+    let (film, stats) = reference::render_reference(
+        ctx,
+        scene,
+        &settings,
+        crate::progressive::Budget::Samples(g.reference_spp),
+        g.dispatch_spp,
+    )?;
     eprintln!("reference: {} spp in {:.1} s", stats.spp, t.elapsed().as_secs_f64());
     reference::write_exr(&path, &film, &reference::header_attributes(&g.scene_spec(), &settings, &stats))?;
     Ok((film.mean, path.display().to_string()))
@@ -873,7 +938,9 @@ fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResul
                         attempt += 1;
                         eprintln!("  lavapipe's loop budget dropped samples at {spp} spp; retrying with {dispatch_spp} spp per dispatch");
                     }
-                    Err(SeedError::Incomplete(spp)) => return Err(format!("{label}: pixels miss samples at {spp} spp even with 1 spp per dispatch")),
+                    Err(SeedError::Incomplete(spp)) => {
+                        return Err(format!("{label}: pixels miss samples at {spp} spp even with 1 spp per dispatch"))
+                    }
                     Err(SeedError::Other(e)) => return Err(e),
                 }
             };
@@ -921,7 +988,10 @@ fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResul
         let last = rows.last().expect("a row");
         eprintln!(
             "  {label}: {} spp: relMSE {:.3e}, {:.3} s GPU, {:.2} M samples/s",
-            last.spp, last.relmse, last.seconds_gpu, last.samples_per_second / 1e6
+            last.spp,
+            last.relmse,
+            last.seconds_gpu,
+            last.samples_per_second / 1e6
         );
         if let Some(mut h) = sum_heat {
             h.iter_mut().for_each(|v| *v /= g.seeds as f64);
@@ -1022,14 +1092,21 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     let mut results = vec![];
     for g in &groups {
         if !crate::scene::builtin::NAMES.contains(&g.scene.as_str()) && !Path::new(&g.scene).exists() {
-            eprintln!("skipping '{}': {} not found", g.name, g.scene);
+            eprintln!("leaving out '{}': {} not found", g.name, g.scene);
             continue;
         }
         if let Some(env) = g.env.as_ref().filter(|e| !e.exists()) {
-            eprintln!("skipping '{}': {} not found", g.name, env.display());
+            eprintln!("leaving out '{}': {} not found", g.name, env.display());
             continue;
         }
-        eprintln!("== {} ({} configurations × {} seeds, {}x{})", g.name, g.configurations().len(), g.seeds, g.width, g.height);
+        eprintln!(
+            "== {} ({} configurations × {} seeds, {}x{})",
+            g.name,
+            g.configurations().len(),
+            g.seeds,
+            g.width,
+            g.height
+        );
         results.push(run_group(&ctx, g, &refs)?);
     }
     write_outputs(&args.out, &ctx, &results)
@@ -1051,7 +1128,10 @@ fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult]) -> Resul
                     labels.push(r.config.clone());
                 }
             }
-            let s = labels.iter().map(|l| summarize(&res.rows.iter().filter(|r| &r.config == l).collect::<Vec<_>>())).collect();
+            let s = labels
+                .iter()
+                .map(|l| summarize(&res.rows.iter().filter(|r| &r.config == l).collect::<Vec<_>>()))
+                .collect();
             (res.group.name.clone(), s)
         })
         .collect();
@@ -1168,7 +1248,8 @@ pub mod plot {
             figure.draw(&root)?;
             root.present().map_err(|e| e.to_string())?;
         }
-        image::save_buffer(path, &buf, w, h, image::ExtendedColorType::Rgb8).map_err(|e| format!("{}: {e}", path.display()))
+        image::save_buffer(path, &buf, w, h, image::ExtendedColorType::Rgb8)
+            .map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Writes `figure` as SVG.
@@ -1259,7 +1340,10 @@ pub mod plot {
                     .label(label.as_str())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
                 chart
-                    .draw_series(p.iter().map(|q| ErrorBar::new_vertical(q.0, q.2.max(y0 / 1.5), q.1, q.3, c.stroke_width(1), 6)))
+                    .draw_series(
+                        p.iter()
+                            .map(|q| ErrorBar::new_vertical(q.0, q.2.max(y0 / 1.5), q.1, q.3, c.stroke_width(1), 6)),
+                    )
                     .map_err(err)?;
                 chart.draw_series(p.iter().map(|q| Circle::new((q.0, q.1), 3, c.filled()))).map_err(err)?;
             }
@@ -1281,14 +1365,31 @@ pub mod plot {
             sums.iter()
                 .map(|s| {
                     let pts = (0..s.spp.len())
-                        .map(|i| (if by_time { s.seconds[i] } else { s.spp[i] as f64 }, s.relmse[i][0], s.relmse[i][1], s.relmse[i][2]))
+                        .map(|i| {
+                            (
+                                if by_time { s.seconds[i] } else { s.spp[i] as f64 },
+                                s.relmse[i][0],
+                                s.relmse[i][1],
+                                s.relmse[i][2],
+                            )
+                        })
                         .collect();
                     (s.config.clone(), pts)
                 })
                 .collect()
         };
-        save(dir, &format!("{base}-error-vs-time"), (900, 600), &ErrorPlot { title: title.into(), x_desc: "GPU seconds".into(), series: series(true) })?;
-        save(dir, &format!("{base}-error-vs-spp"), (900, 600), &ErrorPlot { title: title.into(), x_desc: "samples per pixel".into(), series: series(false) })
+        save(
+            dir,
+            &format!("{base}-error-vs-time"),
+            (900, 600),
+            &ErrorPlot { title: title.into(), x_desc: "GPU seconds".into(), series: series(true) },
+        )?;
+        save(
+            dir,
+            &format!("{base}-error-vs-spp"),
+            (900, 600),
+            &ErrorPlot { title: title.into(), x_desc: "samples per pixel".into(), series: series(false) },
+        )
     }
 
     /// A grid of scalar images on one colour scale.
@@ -1330,8 +1431,11 @@ pub mod plot {
                     for x in 0..self.cells.0 {
                         let c = map(img[y * self.cells.0 + x]);
                         let (px, py) = (x0 + x as f64 * cw, 22.0 + y as f64 * cw);
-                        area.draw(&Rectangle::new([(px as i32, py as i32), ((px + cw).ceil() as i32, (py + cw).ceil() as i32)], c.filled()))
-                            .map_err(err)?;
+                        area.draw(&Rectangle::new(
+                            [(px as i32, py as i32), ((px + cw).ceil() as i32, (py + cw).ceil() as i32)],
+                            c.filled(),
+                        ))
+                        .map_err(err)?;
                     }
                 }
             }
@@ -1341,12 +1445,16 @@ pub mod plot {
             let bx = w as f64 * 0.2;
             for i in 0..steps {
                 let t = i as f64 / (steps - 1) as f64;
-                bar.draw(&Rectangle::new([((bx + i as f64 * bw) as i32, 10), ((bx + (i + 1) as f64 * bw).ceil() as i32, 30)], colormap(t).filled()))
-                    .map_err(err)?;
+                bar.draw(&Rectangle::new(
+                    [((bx + i as f64 * bw) as i32, 10), ((bx + (i + 1) as f64 * bw).ceil() as i32, 30)],
+                    colormap(t).filled(),
+                ))
+                .map_err(err)?;
             }
             let fmt = |v: f64| if self.log { format!("1e{v:.1}") } else { format!("{v:.3}") };
             bar.draw(&Text::new(fmt(self.range.0), (bx as i32 - 60, 14), ("sans-serif", 13))).map_err(err)?;
-            bar.draw(&Text::new(fmt(self.range.1), ((bx + steps as f64 * bw) as i32 + 8, 14), ("sans-serif", 13))).map_err(err)?;
+            bar.draw(&Text::new(fmt(self.range.1), ((bx + steps as f64 * bw) as i32 + 8, 14), ("sans-serif", 13)))
+                .map_err(err)?;
             bar.draw(&Text::new(self.legend.clone(), (bx as i32, 38), ("sans-serif", 13))).map_err(err)?;
             Ok(())
         }
@@ -1370,7 +1478,14 @@ pub mod plot {
     }
 
     /// Per-pixel relMSE heatmaps (log scale, shared range), PNG at up to 128 cells per side, SVG at up to 48.
-    pub fn heatmaps(dir: &Path, base: &str, title: &str, w: u32, h: u32, maps: &[(String, Vec<f64>)]) -> Result<(), String> {
+    pub fn heatmaps(
+        dir: &Path,
+        base: &str,
+        title: &str,
+        w: u32,
+        h: u32,
+        maps: &[(String, Vec<f64>)],
+    ) -> Result<(), String> {
         if maps.is_empty() {
             return Ok(());
         }

@@ -599,7 +599,8 @@ impl<'a, D: Domain> Chi2Test<'a, D> {
             // Cells where the support ends (mixed) or where samples landed although no quadrature point saw the
             // pdf (a support thinner than the point spacing), and their neighbours. Where to refine does not
             // change what is integrated, only how accurately.
-            let seed: Vec<bool> = (0..n_cells).map(|i| mass.mixed[i] || (observed[i] > 0.0 && mass.mass[i] == 0.0)).collect();
+            let seed: Vec<bool> =
+                (0..n_cells).map(|i| mass.mixed[i] || (observed[i] > 0.0 && mass.mass[i] == 0.0)).collect();
             let flagged = dilate(&seed, rows, cols);
             report.refined_cells = flagged.iter().filter(|&&f| f).count();
             if report.refined_cells > 0 {
@@ -651,10 +652,14 @@ impl<'a, D: Domain> Chi2Test<'a, D> {
         let failed_fraction = report.failed as f64 / n.max(1.0);
         let target = if o.may_fail { 1.0 - failed_fraction } else { 1.0 };
         if report.pearson.zero_cell_hits > 0 {
-            report.failures.push(format!("{} samples in cells where the pdf integrates to 0", report.pearson.zero_cell_hits));
+            report
+                .failures
+                .push(format!("{} samples in cells where the pdf integrates to 0", report.pearson.zero_cell_hits));
         }
         if !((report.integral - target).abs() <= o.integral_tolerance) {
-            report.failures.push(format!("∫pdf = {:.5}, expected {:.5} ± {}", report.integral, target, o.integral_tolerance));
+            report
+                .failures
+                .push(format!("∫pdf = {:.5}, expected {:.5} ± {}", report.integral, target, o.integral_tolerance));
         }
         if !(report.pearson.p_value >= o.alpha) {
             report.failures.push(format!("p = {:.3e} < α = {:.3e}", report.pearson.p_value, o.alpha));
@@ -735,7 +740,9 @@ fn integrate_subset<S: Copy>(
         .iter()
         .enumerate()
         .map(|(k, &i)| {
-            let m = (k * per..(k + 1) * per).map(|j| if values[j].is_finite() { values[j] * weights[j] } else { f64::NAN }).sum();
+            let m = (k * per..(k + 1) * per)
+                .map(|j| if values[j].is_finite() { values[j] * weights[j] } else { f64::NAN })
+                .sum();
             (i, m)
         })
         .collect()
@@ -883,7 +890,8 @@ mod tests {
         let mut rng = Pcg64::seed_from_u64(9);
         let samples: Vec<Option<DVec3>> = (0..200_000).map(|_| Some(cosine_hemisphere(&mut rng))).collect();
         let domain = SphereCap::cap_angle(DVec3::new(0.3, 0.1, 1.0), 1.0, (100, 200));
-        let r = Chi2Test::new("cosine in a cap", &domain).run(&samples, &mut |pts| pts.iter().map(|w| w.z.max(0.0) / PI).collect());
+        let r = Chi2Test::new("cosine in a cap", &domain)
+            .run(&samples, &mut |pts| pts.iter().map(|w| w.z.max(0.0) / PI).collect());
         assert!(r.passed(), "{}", r.summary());
     }
 
@@ -893,14 +901,17 @@ mod tests {
         let r = run_sphere("cosine vs uniform", 200_000, cosine_hemisphere, |w| if w.z > 0.0 { 0.5 / PI } else { 0.0 });
         assert!(!r.passed() && r.pearson.p_value < 1e-10, "{}", r.summary());
         // A pdf that is off by 3 % in one half: the chi-square sees it.
-        let r = run_sphere("cosine, 3% off", 1_000_000, cosine_hemisphere, |w| w.z.max(0.0) / PI * if w.x > 0.0 { 1.03 } else { 0.97 });
+        let r = run_sphere("cosine, 3% off", 1_000_000, cosine_hemisphere, |w| {
+            w.z.max(0.0) / PI * if w.x > 0.0 { 1.03 } else { 0.97 }
+        });
         assert!(!r.passed(), "{}", r.summary());
         // Samples where the pdf is 0 fail outright even if the shape is fine elsewhere.
         let mut rng = Pcg64::seed_from_u64(3);
         let mut samples: Vec<Option<DVec3>> = (0..100_000).map(|_| Some(cosine_hemisphere(&mut rng))).collect();
         samples[17] = Some(DVec3::new(0.0, 0.0, -1.0));
         let domain = SphereCap::sphere(DVec3::Z, (100, 200));
-        let r = Chi2Test::new("below the horizon", &domain).run(&samples, &mut |pts| pts.iter().map(|w| w.z.max(0.0) / PI).collect());
+        let r = Chi2Test::new("below the horizon", &domain)
+            .run(&samples, &mut |pts| pts.iter().map(|w| w.z.max(0.0) / PI).collect());
         assert!(r.failures.iter().any(|f| f.contains("integrates to 0")), "{}", r.summary());
     }
 
@@ -949,7 +960,11 @@ mod tests {
                 .map(|w| {
                     let w = w.normalize();
                     let o = w.cross(axis).length_squared() / (1.0 + w.dot(axis));
-                    if o <= omc { 1.0 / (2.0 * PI * omc) } else { 0.0 }
+                    if o <= omc {
+                        1.0 / (2.0 * PI * omc)
+                    } else {
+                        0.0
+                    }
                 })
                 .collect()
         });
@@ -973,14 +988,24 @@ mod tests {
                 Some((v[0] + a * (v[1] - v[0]) + b * (v[2] - v[0]) - p).normalize())
             })
             .collect();
-        let domain = PlaneWindow { p, origin: DVec3::new(0.8, -0.7, 0.0), e1: DVec3::new(2.4, 0.0, 0.0), e2: DVec3::new(0.0, 1.5, 0.0), grid: (100, 200) };
+        let domain = PlaneWindow {
+            p,
+            origin: DVec3::new(0.8, -0.7, 0.0),
+            e1: DVec3::new(2.4, 0.0, 0.0),
+            e2: DVec3::new(0.0, 1.5, 0.0),
+            grid: (100, 200),
+        };
         let pdf = |w: &DVec3| {
             let t = -p.z / w.z;
             let y = p + t * *w;
             let e = [v[1] - v[0], v[2] - v[0]];
             let b1 = (y - v[0]).cross(e[1]).dot(n) / n.dot(n);
             let b2 = e[0].cross(y - v[0]).dot(n) / n.dot(n);
-            if t > 0.0 && b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 { t * t / (area * w.z.abs()) } else { 0.0 }
+            if t > 0.0 && b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 {
+                t * t / (area * w.z.abs())
+            } else {
+                0.0
+            }
         };
         let r = Chi2Test::new("thin triangle", &domain).run(&samples, &mut |pts| pts.iter().map(pdf).collect());
         assert!(r.passed(), "{}", r.summary());
@@ -999,7 +1024,15 @@ mod tests {
         let mut obs = [0u64; 5];
         for _ in 0..100_000 {
             let u: f64 = rng.random();
-            let i = if u < 0.5 { 0 } else if u < 0.75 { 1 } else if u < 0.875 { 2 } else { 3 };
+            let i = if u < 0.5 {
+                0
+            } else if u < 0.75 {
+                1
+            } else if u < 0.875 {
+                2
+            } else {
+                3
+            };
             obs[i] += 1;
         }
         assert!(discrete_test("ok", &obs, &pmf, 0.01).passed());

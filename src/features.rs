@@ -170,8 +170,16 @@ pub struct FixedSettings {
 }
 
 /// Names of the settings constants, in `FixedSettings::tags` order.
-pub const SETTINGS_CONSTANTS: [&str; 8] =
-    ["SPEC_MODE", "SPEC_STRATEGY", "SPEC_LIGHT_SAMPLING", "SPEC_ENV_SAMPLING", "SPEC_LIGHT_SELECT", "SPEC_HEURISTIC", "SPEC_MIS_KIND", "SPEC_SAMPLER"];
+pub const SETTINGS_CONSTANTS: [&str; 8] = [
+    "SPEC_MODE",
+    "SPEC_STRATEGY",
+    "SPEC_LIGHT_SAMPLING",
+    "SPEC_ENV_SAMPLING",
+    "SPEC_LIGHT_SELECT",
+    "SPEC_HEURISTIC",
+    "SPEC_MIS_KIND",
+    "SPEC_SAMPLER",
+];
 
 impl FixedSettings {
     /// The enum choices of `s`.

@@ -62,20 +62,29 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
             vec![
                 Panel { label: "light sampling", settings: with(Strategy::Light) },
                 Panel { label: "BSDF sampling", settings: with(Strategy::Bsdf) },
-                Panel { label: "MIS, balance", settings: Settings { heuristic: Heuristic::Balance, ..with(Strategy::Mis) } },
-                Panel { label: "MIS, power", settings: Settings { heuristic: Heuristic::Power, ..with(Strategy::Mis) } },
+                Panel {
+                    label: "MIS, balance",
+                    settings: Settings { heuristic: Heuristic::Balance, ..with(Strategy::Mis) },
+                },
+                Panel {
+                    label: "MIS, power",
+                    settings: Settings { heuristic: Heuristic::Power, ..with(Strategy::Mis) },
+                },
             ],
         )),
         "area-vs-cosine" => Ok((
             "area-vs-cosine",
             3,
             vec![
-                Panel { label: "area sampling", settings: Settings { light_sampling: LightSampling::Area, ..with(Strategy::Light) } },
+                Panel {
+                    label: "area sampling",
+                    settings: Settings { light_sampling: LightSampling::Area, ..with(Strategy::Light) },
+                },
                 Panel { label: "cosine sampling", settings: with(Strategy::Cosine) },
                 Panel { label: "MIS", settings: with(Strategy::Mis) },
             ],
         )),
-        "samplers" => unreachable!("drawn by sampler_figure"),
+        "samplers" => Err("figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into()),
         other => Err(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", "))),
     }
 }
@@ -84,7 +93,11 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
 pub fn run(args: &FigureArgs) -> Result<(), String> {
     if args.which == "samplers" {
         // One column per sampler, four rows (two point sets, two spectra), each about a panel in size.
-        return crate::sampler_figure::run(&args.output, (args.width * 6).clamp(200, 16384), (args.height * 4).clamp(200, 16384));
+        return crate::sampler_figure::run(
+            &args.output,
+            (args.width * 6).clamp(200, 16384),
+            (args.height * 4).clamp(200, 16384),
+        );
     }
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("png") {
@@ -111,7 +124,11 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
         images.push(img);
     }
     let rows = (images.len() as u32).div_ceil(columns);
-    let mut out = image::RgbImage::from_pixel(columns * args.width + (columns - 1) * GAP, rows * args.height + (rows - 1) * GAP, image::Rgb([255, 255, 255]));
+    let mut out = image::RgbImage::from_pixel(
+        columns * args.width + (columns - 1) * GAP,
+        rows * args.height + (rows - 1) * GAP,
+        image::Rgb([255, 255, 255]),
+    );
     for (k, img) in images.iter().enumerate() {
         let (cx, cy) = (k as u32 % columns, k as u32 / columns);
         image::imageops::replace(&mut out, img, (cx * (args.width + GAP)) as i64, (cy * (args.height + GAP)) as i64);
@@ -138,7 +155,8 @@ fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String>
     let tmp = path.with_extension("png.partial");
     let grey = img.pixels().all(|p| p.0[0] == p.0[1] && p.0[1] == p.0[2]);
     let result = if grey {
-        image::GrayImage::from_fn(img.width(), img.height(), |x, y| image::Luma([img.get_pixel(x, y).0[0]])).save_with_format(&tmp, image::ImageFormat::Png)
+        image::GrayImage::from_fn(img.width(), img.height(), |x, y| image::Luma([img.get_pixel(x, y).0[0]]))
+            .save_with_format(&tmp, image::ImageFormat::Png)
     } else {
         img.save_with_format(&tmp, image::ImageFormat::Png)
     };
@@ -256,10 +274,10 @@ mod tests {
     }
 
     #[test]
-    fn unknown_and_unavailable_figures_are_errors() {
+    fn unknown_figures_are_errors() {
         let base = Settings::default();
         assert!(layout("nope", &base).unwrap_err().contains("expected one of"));
-        assert!(layout("samplers", &base).unwrap_err().contains("not yet"));
+        assert!(layout("samplers", &base).unwrap_err().contains("not rendered in panels"));
         assert_eq!(layout("veach", &base).unwrap().2.len(), 4);
         assert_eq!(layout("area-vs-cosine", &base).unwrap().2.len(), 3);
     }

@@ -204,7 +204,10 @@ impl GpuContext {
 pub fn describe(ctx: &GpuContext) -> String {
     let l = ctx.limits();
     let mut s = String::new();
-    s += &format!("adapter: {} ({:?}, driver {} {})\n", ctx.info.name, ctx.info.device_type, ctx.info.driver, ctx.info.driver_info);
+    s += &format!(
+        "adapter: {} ({:?}, driver {} {})\n",
+        ctx.info.name, ctx.info.device_type, ctx.info.driver, ctx.info.driver_info
+    );
     s += &format!("  max storage buffer binding: {} MiB\n", l.max_storage_buffer_binding_size as u64 >> 20);
     s += &format!("  max buffer size: {} MiB\n", l.max_buffer_size >> 20);
     s += &format!("  max storage buffers per stage: {}\n", l.max_storage_buffers_per_shader_stage);

@@ -113,12 +113,25 @@ impl SceneData {
         d.spheres = scene
             .spheres
             .iter()
-            .map(|s| GpuSphere { center: (s.center - o).into(), radius: s.radius, material: mat_index(s.material), light: INVALID, ..Default::default() })
+            .map(|s| GpuSphere {
+                center: (s.center - o).into(),
+                radius: s.radius,
+                material: mat_index(s.material),
+                light: INVALID,
+                ..Default::default()
+            })
             .collect();
         d.quads = scene
             .quads
             .iter()
-            .map(|q| GpuQuad { corner: (q.corner - o).into(), edge_u: q.edge_u.into(), edge_v: q.edge_v.into(), material: mat_index(q.material), light: INVALID, ..Default::default() })
+            .map(|q| GpuQuad {
+                corner: (q.corner - o).into(),
+                edge_u: q.edge_u.into(),
+                edge_v: q.edge_v.into(),
+                material: mat_index(q.material),
+                light: INVALID,
+                ..Default::default()
+            })
             .collect();
         let mut extent = 0.0f32;
         for v in tris.iter().flatten() {
@@ -278,7 +291,12 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     for l in &scene.punctual_lights {
         let (g, p) = match *l {
             PunctualLight::Point { position, intensity } => (
-                GpuLight { kind: LIGHT_POINT, position: (position - d.origin).into(), radiance: intensity.into(), ..Default::default() },
+                GpuLight {
+                    kind: LIGHT_POINT,
+                    position: (position - d.origin).into(),
+                    radiance: intensity.into(),
+                    ..Default::default()
+                },
                 4.0 * PI * luminance(intensity.into()),
             ),
             PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } => {
@@ -295,7 +313,12 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
                 (g, 2.0 * PI * (1.0 - 0.5 * (ci + co) as f64) * luminance(intensity.into()))
             }
             PunctualLight::Directional { direction, irradiance } => (
-                GpuLight { kind: LIGHT_DIRECTIONAL, direction: direction.normalize_or(Vec3::NEG_Y).into(), radiance: irradiance.into(), ..Default::default() },
+                GpuLight {
+                    kind: LIGHT_DIRECTIONAL,
+                    direction: direction.normalize_or(Vec3::NEG_Y).into(),
+                    radiance: irradiance.into(),
+                    ..Default::default()
+                },
                 PI * r * r * luminance(irradiance.into()),
             ),
         };
@@ -348,8 +371,19 @@ pub struct GpuScene {
 
 /// Names of the group-0 bindings, in order (for messages about device limits).
 pub const BINDING_NAMES: [&str; 13] = [
-    "BVH nodes", "primitive references", "triangle vertices", "spheres", "quads", "triangle shading data", "materials",
-    "lights", "light alias table", "texture table", "texels", "environment texels", "environment alias table",
+    "BVH nodes",
+    "primitive references",
+    "triangle vertices",
+    "spheres",
+    "quads",
+    "triangle shading data",
+    "materials",
+    "lights",
+    "light alias table",
+    "texture table",
+    "texels",
+    "environment texels",
+    "environment alias table",
 ];
 
 /// Bytes of each group-0 buffer of `data`, in binding order (see [`BINDING_NAMES`]).

@@ -3,25 +3,25 @@
 //! Data flows one way (see `../shared/DESIGN.md`): scene file → [`scene::Scene`] → [`gpu_scene::GpuScene`]
 //! (+ [`bvh`], [`lights`]) → [`render::Renderer`] (progressive accumulation) → [`film`] (PNG / EXR).
 
-pub mod bvh;
-pub mod gpu;
-pub mod gpu_types;
-pub mod probe;
-pub mod scene;
-pub mod shaders;
-pub mod film;
-pub mod gpu_scene;
-pub mod lights;
-pub mod render;
-pub mod settings;
-pub mod progressive;
-pub mod features;
-pub mod chi2;
-pub mod viewer;
-pub mod samplers;
-pub mod metrics;
 pub mod bench;
-pub mod reference;
-pub mod sampler_figure;
+pub mod bvh;
+pub mod chi2;
+pub mod features;
 pub mod figure;
+pub mod film;
+pub mod gpu;
+pub mod gpu_scene;
+pub mod gpu_types;
+pub mod lights;
+pub mod metrics;
+pub mod probe;
+pub mod progressive;
+pub mod reference;
+pub mod render;
+pub mod sampler_figure;
+pub mod samplers;
+pub mod scene;
+pub mod settings;
+pub mod shaders;
 pub mod stress;
+pub mod viewer;

@@ -91,11 +91,11 @@ pub fn env_distribution(map: &EnvMap) -> EnvDistribution {
         }
     }
     let table = alias_table(&weights);
-    let texels = map
-        .texels
-        .iter()
-        .zip(&table.pmf)
-        .map(|(c, p)| [c[0], c[1], c[2], (p * (w * h) as f64) as f32])
-        .collect();
-    EnvDistribution { texels, alias: table.entries, mean_luminance: if sin_sum > 0.0 { lum_sum / sin_sum } else { 0.0 } }
+    let texels =
+        map.texels.iter().zip(&table.pmf).map(|(c, p)| [c[0], c[1], c[2], (p * (w * h) as f64) as f32]).collect();
+    EnvDistribution {
+        texels,
+        alias: table.entries,
+        mean_luminance: if sin_sum > 0.0 { lum_sum / sin_sum } else { 0.0 },
+    }
 }

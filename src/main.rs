@@ -20,7 +20,11 @@ const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_INTERRUPTED: u8 = 130;
 
 #[derive(Parser)]
-#[command(name = "mislab", version, about = "A GPU Monte Carlo renderer for seeing, measuring and trusting sampling strategies")]
+#[command(
+    name = "mislab",
+    version,
+    about = "A GPU Monte Carlo renderer for seeing, measuring and trusting sampling strategies"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -230,7 +234,8 @@ fn load_scene(args: &SceneArgs) -> Result<scene::Scene, Failure> {
     if let Some(env) = &args.env {
         let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| bad(e.to_string()))?;
         scene.warnings.extend(warnings);
-        scene.environment = Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
+        scene.environment =
+            Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
     }
     let geometry = scene.triangle_count() + scene.spheres.len() + scene.quads.len();
     if !scene.has_lights() && geometry > 0 {
@@ -261,12 +266,25 @@ fn stress(filter: Option<&str>) -> Result<u8, Failure> {
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let outcomes = mislab::stress::run(&ctx, filter, |o| {
-        eprintln!("{} {:<12} {:<50} NaN/Inf {:>3}  {}", if o.pass { "pass" } else { "FAIL" }, o.group, o.name, o.nonfinite, o.detail);
+        eprintln!(
+            "{} {:<12} {:<50} NaN/Inf {:>3}  {}",
+            if o.pass { "pass" } else { "FAIL" },
+            o.group,
+            o.name,
+            o.nonfinite,
+            o.detail
+        );
     })
     .map_err(bad)?;
     println!("{}", mislab::stress::table(&outcomes));
     let failed = outcomes.iter().filter(|o| !o.pass).count();
-    println!("{} cases, {} passed, {} failed, {} NaN/Inf samples in all", outcomes.len(), outcomes.len() - failed, failed, outcomes.iter().map(|o| o.nonfinite).sum::<u64>());
+    println!(
+        "{} cases, {} passed, {} failed, {} NaN/Inf samples in all",
+        outcomes.len(),
+        outcomes.len() - failed,
+        failed,
+        outcomes.iter().map(|o| o.nonfinite).sum::<u64>()
+    );
     Ok(if failed == 0 { 0 } else { 1 })
 }
 
@@ -347,7 +365,8 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         Budget::Time(t) => indicatif::ProgressBar::new((t.as_secs_f64() * 1000.0) as u64),
     };
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let pixels = (settings.width * settings.height) as f64;
     let stats = progressive::run(&ctx, &mut renderer, budget, &interrupt, |spp, secs| {
@@ -370,7 +389,11 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         stats.nonfinite
     );
     if stats.interrupted {
-        eprintln!("interrupted: wrote the {} samples per pixel accumulated so far to {}", stats.spp, args.output.display());
+        eprintln!(
+            "interrupted: wrote the {} samples per pixel accumulated so far to {}",
+            stats.spp,
+            args.output.display()
+        );
         return Ok(EXIT_INTERRUPTED);
     }
     eprintln!("wrote {}", args.output.display());
@@ -405,7 +428,13 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
                 Environment::Map { map, .. } => format!("map {} ({}x{})", map.path.display(), map.width, map.height),
             }
         );
-        println!("BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes", data.bvh_nodes.len(), data.bvh_seconds * 1e3, data.bvh_sah, data.bvh_bytes());
+        println!(
+            "BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes",
+            data.bvh_nodes.len(),
+            data.bvh_seconds * 1e3,
+            data.bvh_sah,
+            data.bvh_bytes()
+        );
         let features = mislab::features::Features::of(&data);
         println!("features (code paths compiled into its specialised pipelines): {}", features.describe());
     }

@@ -237,7 +237,8 @@ impl<'a> Probe<'a> {
         }
         let n = inputs.len() as u64;
         assert!(n <= u32::MAX as u64, "too many probe inputs");
-        let source = format!("{library}\n{}", map_kernel(in_type, out_type, function, library.contains("fn bvh_set_lane")));
+        let source =
+            format!("{library}\n{}", map_kernel(in_type, out_type, function, library.contains("fn bvh_set_lane")));
         let groups = n.div_ceil(MAP_WORKGROUP_SIZE as u64) as u32;
         let max = self.ctx.limits().max_compute_workgroups_per_dimension.max(1);
         let workgroups = [groups.min(max), groups.div_ceil(max), 1];

@@ -42,11 +42,16 @@ pub struct SceneSpec {
 impl SceneSpec {
     /// Loads the scene and applies the environment override; prints the loader's warnings.
     pub fn load(&self) -> Result<Scene, String> {
-        let mut s = scene::load(&self.scene, &LoadOptions { gltf_scene: self.gltf_scene }).map_err(|e| e.to_string())?;
+        let mut s =
+            scene::load(&self.scene, &LoadOptions { gltf_scene: self.gltf_scene }).map_err(|e| e.to_string())?;
         if let Some(env) = &self.env {
             let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| e.to_string())?;
             s.warnings.extend(warnings);
-            s.environment = Environment::Map { map: Arc::new(map), scale: self.env_scale, rotation: self.env_rotation.to_radians() };
+            s.environment = Environment::Map {
+                map: Arc::new(map),
+                scale: self.env_scale,
+                rotation: self.env_rotation.to_radians(),
+            };
         }
         for w in &s.warnings {
             eprintln!("warning: {}: {w}", self.scene);
@@ -112,7 +117,13 @@ pub fn reference_settings(base: &Settings) -> Settings {
 }
 
 /// Renders a reference to a budget in small, checked dispatches (see `bench`: lavapipe's loop budget).
-pub fn render_reference(ctx: &GpuContext, scene: &Scene, settings: &Settings, budget: Budget, dispatch_spp: u32) -> Result<(Film, RenderStats), String> {
+pub fn render_reference(
+    ctx: &GpuContext,
+    scene: &Scene,
+    settings: &Settings,
+    budget: Budget,
+    dispatch_spp: u32,
+) -> Result<(Film, RenderStats), String> {
     let gpu_scene = GpuScene::upload(ctx, SceneData::build(scene)).map_err(|e| e.to_string())?;
     let mut r = Renderer::new(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?;
     let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { default_dispatch_spp(settings.mode) };
@@ -180,7 +191,9 @@ pub fn header_attributes(scene: &SceneSpec, settings: &Settings, stats: &RenderS
 
 fn text(s: &str) -> exr::meta::attribute::Text {
     use exr::meta::attribute::Text;
-    Text::new_or_none(s).unwrap_or_else(|| Text::new_or_panic(s.chars().map(|c| if (c as u32) < 256 { c } else { '?' }).collect::<String>()))
+    Text::new_or_none(s).unwrap_or_else(|| {
+        Text::new_or_panic(s.chars().map(|c| if (c as u32) < 256 { c } else { '?' }).collect::<String>())
+    })
 }
 
 /// Writes linear RGB float32 EXR with `attributes` as text attributes of the layer (written to a temporary
@@ -204,7 +217,10 @@ pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> R
         }),
     );
     let tmp = path.with_extension("exr.partial");
-    Image::from_layer(layer).write().to_file(&tmp).map_err(|e| format!("{}: could not write the EXR: {e}", path.display()))?;
+    Image::from_layer(layer)
+        .write()
+        .to_file(&tmp)
+        .map_err(|e| format!("{}: could not write the EXR: {e}", path.display()))?;
     std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
 }
 

@@ -88,17 +88,29 @@ impl Renderer {
 
     /// The per-render buffers only, with no pipeline yet: the viewer compiles pipelines on another
     /// thread and hands them in with `insert_pipeline` (compiling takes seconds on lavapipe).
-    pub fn new_unprepared(ctx: &GpuContext, scene: &GpuScene, camera: Camera, settings: Settings) -> Result<Renderer, String> {
+    pub fn new_unprepared(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        camera: Camera,
+        settings: Settings,
+    ) -> Result<Renderer, String> {
         settings.validate()?;
         let device = ctx.device.clone();
         let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
             count: None,
         };
         let scene_entries: Vec<_> = (0..scene.buffers.len() as u32).map(|i| storage(i, true)).collect();
-        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("scene"), entries: &scene_entries });
+        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &scene_entries,
+        });
         let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &[
@@ -128,7 +140,11 @@ impl Renderer {
             .enumerate()
             .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
             .collect();
-        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("scene"), layout: &layout0, entries: &entries });
+        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout0,
+            entries: &entries,
+        });
         let pixels = settings.width as u64 * settings.height as u64;
         let accum_bytes = pixels * std::mem::size_of::<GpuAccum>() as u64;
         if accum_bytes > ctx.max_storage_binding() {
@@ -158,7 +174,8 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let sampler_data = ctx.storage_buffer("sampler_data", crate::samplers::sampler_data(), wgpu::BufferUsages::empty());
+        let sampler_data =
+            ctx.storage_buffer("sampler_data", crate::samplers::sampler_data(), wgpu::BufferUsages::empty());
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
             layout: &layout1,
@@ -231,7 +248,14 @@ impl Renderer {
     pub fn prepare(&mut self) -> Result<(), String> {
         let key = self.key();
         if !self.pipelines.contains_key(&key) {
-            let p = shaders::compute_pipeline(&self.device, "render", &render_source(), "render_main", &key.constants(), Some(&self.pipeline_layout))?;
+            let p = shaders::compute_pipeline(
+                &self.device,
+                "render",
+                &render_source(),
+                "render_main",
+                &key.constants(),
+                Some(&self.pipeline_layout),
+            )?;
             self.pipelines.insert(key, p);
         }
         Ok(())
@@ -346,7 +370,8 @@ impl Renderer {
         let row_count = row_count.min(self.settings.height - row_offset);
         let p = GpuFrameParams { row_offset, row_count, ..self.frame_params(spp) };
         self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: timestamps });
+        let mut pass = enc
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: timestamps });
         let pipeline = self.pipelines.get(&self.key()).expect("prepare() builds the pipeline before encoding");
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.scene_group, &[]);
@@ -379,7 +404,11 @@ impl Renderer {
         if let Some(n) = self.dispatch_spp {
             return n;
         }
-        if self.settings.mode == Mode::Path { 4 } else { 16 }
+        if self.settings.mode == Mode::Path {
+            4
+        } else {
+            16
+        }
     }
 
     /// The pipeline built for `key`, to share with another renderer (`insert_pipeline`).

@@ -183,12 +183,20 @@ impl Figure for SamplerFigure {
                 let y0 = 20.0;
                 let caption = if r == 0 { format!("{}: {}", kind.name(), row_names[r]) } else { row_names[r].clone() };
                 area.draw(&Text::new(caption, (x0 as i32, 2), ("sans-serif", 12))).map_err(err)?;
-                let frame = Rectangle::new([(x0 as i32, y0 as i32), ((x0 + side) as i32, (y0 + side) as i32)], BLACK.stroke_width(1));
+                let frame = Rectangle::new(
+                    [(x0 as i32, y0 as i32), ((x0 + side) as i32, (y0 + side) as i32)],
+                    BLACK.stroke_width(1),
+                );
                 if r < 2 {
                     let pts = if r == 0 { &self.points[c].0 } else { &self.points[c].1 };
                     for (i, p) in pts.iter().enumerate() {
                         let (px, py) = (x0 + p[0] as f64 * side, y0 + (1.0 - p[1] as f64) * side);
-                        area.draw(&Circle::new((px as i32, py as i32), if i < 16 { 3 } else { 2 }, point_color(i).filled())).map_err(err)?;
+                        area.draw(&Circle::new(
+                            (px as i32, py as i32),
+                            if i < 16 { 3 } else { 2 },
+                            point_color(i).filled(),
+                        ))
+                        .map_err(err)?;
                     }
                 } else {
                     let (img, n, ratio) = &self.spectra[c][r - 2];
@@ -205,8 +213,12 @@ impl Figure for SamplerFigure {
                             .map_err(err)?;
                         }
                     }
-                    area.draw(&Text::new(format!("low-frequency power {ratio:.2}× mean"), (x0 as i32, (y0 + side) as i32 + 2), ("sans-serif", 11)))
-                        .map_err(err)?;
+                    area.draw(&Text::new(
+                        format!("low-frequency power {ratio:.2}× mean"),
+                        (x0 as i32, (y0 + side) as i32 + 2),
+                        ("sans-serif", 11),
+                    ))
+                    .map_err(err)?;
                 }
                 area.draw(&frame).map_err(err)?;
             }

@@ -45,7 +45,8 @@ pub fn compose(files: &[&str], extra: &str) -> String {
 /// Parses and validates a composed module with naga, returning the module or a readable error.
 pub fn validate(source: &str) -> Result<naga::Module, String> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
-    let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+    let mut validator =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
     validator.validate(&module).map_err(|e| e.emit_to_string(source))?;
     Ok(module)
 }

@@ -81,7 +81,14 @@ fn settings(strategy: Strategy) -> Settings {
     Settings { width: SIZE, height: SIZE, strategy, ..Settings::default() }
 }
 
-fn case(group: &'static str, name: impl Into<String>, scene: Scene, settings: Settings, spp: u32, check: Check) -> Case {
+fn case(
+    group: &'static str,
+    name: impl Into<String>,
+    scene: Scene,
+    settings: Settings,
+    spp: u32,
+    check: Check,
+) -> Case {
     Case { group, name: name.into(), scene, settings, spp, dispatch_spp: None, check }
 }
 
@@ -139,9 +146,19 @@ fn builtin(name: &str) -> Scene {
 /// looks at `target` with a narrow field of view (so every pixel sees about the same floor point).
 fn floor_scene(name: &str, half: f32, eye: Vec3, target: Vec3, vfov_degrees: f32) -> Scene {
     let mut s = Scene { name: name.into(), ..Default::default() };
-    s.camera = Camera::look_at(eye, target, if (eye - target).cross(Vec3::Y).length() < 1e-6 * (eye - target).length() { Vec3::Z } else { Vec3::Y }, vfov_degrees);
+    s.camera = Camera::look_at(
+        eye,
+        target,
+        if (eye - target).cross(Vec3::Y).length() < 1e-6 * (eye - target).length() { Vec3::Z } else { Vec3::Y },
+        vfov_degrees,
+    );
     s.materials.push(Material::lambert("floor", Vec3::splat(RHO as f32)));
-    s.quads.push(Quad { corner: Vec3::new(-half, 0.0, -half), edge_u: Vec3::new(0.0, 0.0, 2.0 * half), edge_v: Vec3::new(2.0 * half, 0.0, 0.0), material: 0 });
+    s.quads.push(Quad {
+        corner: Vec3::new(-half, 0.0, -half),
+        edge_u: Vec3::new(0.0, 0.0, 2.0 * half),
+        edge_v: Vec3::new(2.0 * half, 0.0, 0.0),
+        material: 0,
+    });
     s
 }
 
@@ -176,7 +193,13 @@ fn sphere_over_floor(r: f64, l: f64, d: f64) -> (Scene, f64) {
 fn polygon_over_floor(triangle: bool, size: f64, h: f64, l: f64) -> (Scene, f64) {
     let (hf, sf) = (h as f32, size as f32);
     let cam_h = 0.5 * hf.min(sf.max(hf));
-    let mut s = floor_scene("polygon-over-floor", (10.0 * sf).max(10.0 * hf), Vec3::new(1.5 * cam_h, cam_h, 0.0), Vec3::ZERO, 0.5);
+    let mut s = floor_scene(
+        "polygon-over-floor",
+        (10.0 * sf).max(10.0 * hf),
+        Vec3::new(1.5 * cam_h, cam_h, 0.0),
+        Vec3::ZERO,
+        0.5,
+    );
     s.materials.push(Material::emitter("light", Vec3::splat(l as f32)));
     let corner = Vec3::new(-0.5 * sf, hf, -0.5 * sf);
     let (eu, ev) = (Vec3::new(sf, 0.0, 0.0), Vec3::new(0.0, 0.0, sf));
@@ -199,7 +222,8 @@ fn polygon_over_floor(triangle: bool, size: f64, h: f64, l: f64) -> (Scene, f64)
 /// the black outside, and one that re-hit its own triangle would break the count.
 fn closed_emitting_sphere(c: DVec3, r: f64, levels: u32) -> Scene {
     let mut verts: Vec<DVec3> = vec![DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z];
-    let mut tris: Vec<[u32; 3]> = vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    let mut tris: Vec<[u32; 3]> =
+        vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
     for _ in 0..levels {
         let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
         let mut next = Vec::new();
@@ -260,7 +284,12 @@ fn emitter_wall(l: f32) -> Scene {
     let mut s = Scene { name: "wall".into(), ..Default::default() };
     s.camera = Camera::look_at(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, Vec3::Y, 10.0);
     s.materials.push(Material::emitter("wall", Vec3::splat(l)));
-    s.quads.push(Quad { corner: Vec3::new(-1.0, -1.0, 0.0), edge_u: Vec3::new(2.0, 0.0, 0.0), edge_v: Vec3::new(0.0, 2.0, 0.0), material: 0 });
+    s.quads.push(Quad {
+        corner: Vec3::new(-1.0, -1.0, 0.0),
+        edge_u: Vec3::new(2.0, 0.0, 0.0),
+        edge_v: Vec3::new(0.0, 2.0, 0.0),
+        material: 0,
+    });
     s
 }
 
@@ -274,17 +303,43 @@ pub fn cases() -> Result<Vec<Case>, String> {
     for (mode_name, st) in [("direct", &mis), ("path", &path)] {
         let twin = format!("cornell {mode_name} scale 1");
         out.push(case("scale", &twin, builtin("cornell-box"), st.clone(), 32, Check::Finite));
-        let scales: &[f32] = if mode_name == "direct" { &[1e-4, 1e-3, 1e-2, 1e-1, 1e1, 1e2, 1e3, 1e4, 1e5] } else { &[1e-4, 1e5] };
+        let scales: &[f32] =
+            if mode_name == "direct" { &[1e-4, 1e-3, 1e-2, 1e-1, 1e1, 1e2, 1e3, 1e4, 1e5] } else { &[1e-4, 1e5] };
         for &k in scales {
             let sc = transformed(builtin("cornell-box"), k, Vec3::ZERO);
-            out.push(case("scale", format!("cornell {mode_name} scale {k:e}"), sc, st.clone(), 32, Check::SameAs { twin: twin.clone(), rel_tol: 0.01 }));
+            out.push(case(
+                "scale",
+                format!("cornell {mode_name} scale {k:e}"),
+                sc,
+                st.clone(),
+                32,
+                Check::SameAs { twin: twin.clone(), rel_tol: 0.01 },
+            ));
         }
         let sc = transformed(builtin("cornell-box"), 1.0, Vec3::splat(1e5));
-        out.push(case("scale", format!("cornell {mode_name} offset 1e5"), sc, st.clone(), 32, Check::SameAs { twin: twin.clone(), rel_tol: 0.02 }));
+        out.push(case(
+            "scale",
+            format!("cornell {mode_name} offset 1e5"),
+            sc,
+            st.clone(),
+            32,
+            Check::SameAs { twin: twin.clone(), rel_tol: 0.02 },
+        ));
     }
 
     // Sphere lights of radius 1e-5 … 1e3 and radiance 1e-3 … 1e7 over a floor: ρ·L·(r/d)² at the foot point.
-    for (r, l) in [(1e-5, 1e7), (1e-4, 1e5), (1e-3, 1e3), (1e-2, 1e1), (1e-1, 1.0), (1.0, 1e-1), (1e1, 1e-2), (1e2, 1e-3), (1e3, 1e-3), (1e3, 1e7)] {
+    for (r, l) in [
+        (1e-5, 1e7),
+        (1e-4, 1e5),
+        (1e-3, 1e3),
+        (1e-2, 1e1),
+        (1e-1, 1.0),
+        (1.0, 1e-1),
+        (1e1, 1e-2),
+        (1e2, 1e-3),
+        (1e3, 1e-3),
+        (1e3, 1e7),
+    ] {
         let d = if r < 0.4 { 1.0 } else { 2.5 * r };
         for (label, st) in [
             ("mis solid-angle", mis.clone()),
@@ -294,7 +349,14 @@ pub fn cases() -> Result<Vec<Case>, String> {
                 continue;
             }
             let (sc, e) = sphere_over_floor(r, l, d);
-            out.push(case("sphere light", format!("r {r:e} L {l:e} {label}"), sc, st, 16, Check::Mean { expected: e, rel_tol: 0.01 }));
+            out.push(case(
+                "sphere light",
+                format!("r {r:e} L {l:e} {label}"),
+                sc,
+                st,
+                16,
+                Check::Mean { expected: e, rel_tol: 0.01 },
+            ));
         }
     }
     // Solid-angle sampling's fallbacks: tiny triangles and quads (area sampling), and a huge quad nearly
@@ -303,20 +365,43 @@ pub fn cases() -> Result<Vec<Case>, String> {
         let kind = if triangle { "triangle" } else { "quad" };
         for (size, h, l) in [(1e-5, 1.0, 1e9), (1e-3, 1.0, 1e5), (1e3, 1e-3, 1.0)] {
             let (sc, e) = polygon_over_floor(triangle, size, h, l);
-            out.push(case("fallbacks", format!("{kind} light {size:e} at {h:e}"), sc, mis.clone(), 16, Check::Mean { expected: e, rel_tol: 0.01 }));
+            out.push(case(
+                "fallbacks",
+                format!("{kind} light {size:e} at {h:e}"),
+                sc,
+                mis.clone(),
+                16,
+                Check::Mean { expected: e, rel_tol: 0.01 },
+            ));
         }
     }
     // A sphere light subtending 1e-6 sr-ish and one enclosing a large solid angle, by cone sampling only.
     let (sc, e) = sphere_over_floor(5e-4, 1e4, 1.0);
-    out.push(case("fallbacks", "sphere 5e-4 light solid-angle", sc, settings(Strategy::Light), 16, Check::Mean { expected: e, rel_tol: 0.01 }));
+    out.push(case(
+        "fallbacks",
+        "sphere 5e-4 light solid-angle",
+        sc,
+        settings(Strategy::Light),
+        16,
+        Check::Mean { expected: e, rel_tol: 0.01 },
+    ));
     // A sphere filling most of the sky (its cone half-angle 64°), seen from low down between it and the floor.
     let (mut sc, e) = sphere_over_floor(0.9, 1.0, 1.0);
     sc.camera = Camera::look_at(Vec3::new(1.5, 0.05, 0.0), Vec3::ZERO, Vec3::Y, 0.05);
-    out.push(case("fallbacks", "sphere light filling the sky, light solid-angle", sc, settings(Strategy::Light), 16, Check::Mean { expected: e, rel_tol: 0.01 }));
+    out.push(case(
+        "fallbacks",
+        "sphere light filling the sky, light solid-angle",
+        sc,
+        settings(Strategy::Light),
+        16,
+        Check::Mean { expected: e, rel_tol: 0.01 },
+    ));
 
     // Grazing light and view (89.9°): a directional light on the Lambert floor, E = E0·cos θ.
     let graze = 89.9f64.to_radians();
-    for (label, light_angle, view_grazing) in [("light 89.9°", graze, false), ("view 89.9°", 0.25 * PI, true), ("both 89.9°", graze, true)] {
+    for (label, light_angle, view_grazing) in
+        [("light 89.9°", graze, false), ("view 89.9°", 0.25 * PI, true), ("both 89.9°", graze, true)]
+    {
         let (eye, target, fov) = if view_grazing {
             let dist = 1.0 / (0.5 * PI - graze).tan();
             (Vec3::new(0.0, 1.0, dist as f32), Vec3::ZERO, 0.01)
@@ -338,16 +423,46 @@ pub fn cases() -> Result<Vec<Case>, String> {
     // GGX roughness 0 (clamped to α = 1e-4), 1e-4 and 1 on a Fresnel-1 conductor in a white furnace: a
     // near-mirror reflects the white environment exactly; at roughness 1 light and BSDF sampling agree.
     for (label, alpha) in [("roughness 0", 0.0f32), ("roughness 1e-2", 1e-4)] {
-        out.push(case("ggx", label, furnace_with(Material::conductor("metal", Vec3::ONE, alpha)), mis.clone(), 16, Check::Mean { expected: 1.0, rel_tol: 0.01 }));
+        out.push(case(
+            "ggx",
+            label,
+            furnace_with(Material::conductor("metal", Vec3::ONE, alpha)),
+            mis.clone(),
+            16,
+            Check::Mean { expected: 1.0, rel_tol: 0.01 },
+        ));
     }
-    out.push(case("ggx", "roughness 1e-4, path", furnace_with(Material::conductor("metal", Vec3::ONE, 1e-8)), path.clone(), 8, Check::Mean { expected: 1.0, rel_tol: 0.01 }));
+    out.push(case(
+        "ggx",
+        "roughness 1e-4, path",
+        furnace_with(Material::conductor("metal", Vec3::ONE, 1e-8)),
+        path.clone(),
+        8,
+        Check::Mean { expected: 1.0, rel_tol: 0.01 },
+    ));
     let rough = furnace_with(Material::conductor("metal", Vec3::ONE, 1.0));
     out.push(case("ggx", "roughness 1, mis", rough.clone(), mis.clone(), 64, Check::Finite));
-    out.push(case("ggx", "roughness 1, light", rough.clone(), settings(Strategy::Light), 256, Check::SameAs { twin: "roughness 1, mis".into(), rel_tol: 0.005 }));
-    out.push(case("ggx", "roughness 1, bsdf", rough, settings(Strategy::Bsdf), 64, Check::SameAs { twin: "roughness 1, mis".into(), rel_tol: 0.005 }));
+    out.push(case(
+        "ggx",
+        "roughness 1, light",
+        rough.clone(),
+        settings(Strategy::Light),
+        256,
+        Check::SameAs { twin: "roughness 1, mis".into(), rel_tol: 0.005 },
+    ));
+    out.push(case(
+        "ggx",
+        "roughness 1, bsdf",
+        rough,
+        settings(Strategy::Bsdf),
+        64,
+        Check::SameAs { twin: "roughness 1, mis".into(), rel_tol: 0.005 },
+    ));
 
     // Lights touching and intersecting surfaces; shading points on a light.
-    for (label, center_y) in [("sphere light touching the floor", 0.3f32), ("sphere light half sunk into the floor", 0.0)] {
+    for (label, center_y) in
+        [("sphere light touching the floor", 0.3f32), ("sphere light half sunk into the floor", 0.0)]
+    {
         let mut sc = floor_scene("touching", 5.0, Vec3::new(0.0, 2.0, 3.0), Vec3::ZERO, 40.0);
         sc.materials.push(Material::emitter("light", Vec3::splat(5.0)));
         sc.spheres.push(Sphere { center: Vec3::new(0.0, center_y, 0.0), radius: 0.3, material: 1 });
@@ -361,7 +476,12 @@ pub fn cases() -> Result<Vec<Case>, String> {
         let mut m = Material::lambert("glowing floor", Vec3::splat(0.5));
         m.emission = Vec3::splat(2.0);
         sc.materials.push(m);
-        sc.quads.push(Quad { corner: Vec3::new(-1.0, 0.0, -1.0), edge_u: Vec3::new(0.0, 0.0, 2.0), edge_v: Vec3::new(2.0, 0.0, 0.0), material: 1 });
+        sc.quads.push(Quad {
+            corner: Vec3::new(-1.0, 0.0, -1.0),
+            edge_u: Vec3::new(0.0, 0.0, 2.0),
+            edge_v: Vec3::new(2.0, 0.0, 0.0),
+            material: 1,
+        });
         sc.materials.push(Material::emitter("light", Vec3::splat(4.0)));
         sc.spheres.push(Sphere { center: Vec3::new(0.0, 1.5, 0.0), radius: 0.2, material: 2 });
         out.push(case("contact", "shading points on a light", sc.clone(), mis.clone(), 16, Check::Finite));
@@ -387,14 +507,36 @@ pub fn cases() -> Result<Vec<Case>, String> {
         sc.materials.push(Material::lambert("floor", Vec3::splat(RHO as f32)));
         sc.meshes.push(mesh("floor", positions.clone(), indices.clone(), 0));
         sc.environment = Environment::Constant(Vec3::ONE);
-        out.push(case("degenerate", "degenerate triangles in a floor", sc.clone(), mis.clone(), 16, Check::Mean { expected: RHO, rel_tol: 0.01 }));
-        out.push(case("degenerate", "degenerate triangles in a floor, path", sc.clone(), path.clone(), 8, Check::Mean { expected: RHO, rel_tol: 0.01 }));
+        out.push(case(
+            "degenerate",
+            "degenerate triangles in a floor",
+            sc.clone(),
+            mis.clone(),
+            16,
+            Check::Mean { expected: RHO, rel_tol: 0.01 },
+        ));
+        out.push(case(
+            "degenerate",
+            "degenerate triangles in a floor, path",
+            sc.clone(),
+            path.clone(),
+            8,
+            Check::Mean { expected: RHO, rel_tol: 0.01 },
+        ));
         // The same triangles (bar the huge one) as emitters above the floor: zero-area lights get no samples.
         let mut lit = floor_scene("degenerate-lights", 5.0, Vec3::new(0.0, 2.0, 3.0), Vec3::ZERO, 40.0);
         lit.materials.push(Material::emitter("degenerate light", Vec3::splat(10.0)));
-        let lifted: Vec<Vec3> = positions.iter().map(|v| Vec3::new(v.x, 1.0 + v.z * 1e-3, v.z.clamp(-2.0, 2.0))).collect();
+        let lifted: Vec<Vec3> =
+            positions.iter().map(|v| Vec3::new(v.x, 1.0 + v.z * 1e-3, v.z.clamp(-2.0, 2.0))).collect();
         lit.meshes.push(mesh("lights", lifted, indices[1..].to_vec(), 1));
-        out.push(case("degenerate", "degenerate emissive triangles", lit, Settings { light_select: crate::settings::LightSelect::Power, ..mis.clone() }, 16, Check::Finite));
+        out.push(case(
+            "degenerate",
+            "degenerate emissive triangles",
+            lit,
+            Settings { light_select: crate::settings::LightSelect::Power, ..mis.clone() },
+            16,
+            Check::Finite,
+        ));
     }
 
     // Closed meshes at coordinates 10^U(−8, 8): rays never slip through shared vertices or re-hit their own
@@ -426,11 +568,20 @@ pub fn cases() -> Result<Vec<Case>, String> {
         bad[1000] = [f32::NEG_INFINITY, f32::NAN, -0.0];
         let (env, warnings) = env_from_texels("bad-texels", w, h, &bad)?;
         if warnings.len() != 1 {
-            return Err(format!("a map with NaN/Inf/negative texels should give exactly one warning, got {warnings:?}"));
+            return Err(format!(
+                "a map with NaN/Inf/negative texels should give exactly one warning, got {warnings:?}"
+            ));
         }
         let mut sc = builtin("furnace");
         sc.environment = env;
-        out.push(case("environment", "NaN/Inf/negative texels, importance", sc.clone(), mis.clone(), 16, Check::Finite));
+        out.push(case(
+            "environment",
+            "NaN/Inf/negative texels, importance",
+            sc.clone(),
+            mis.clone(),
+            16,
+            Check::Finite,
+        ));
         out.push(case("environment", "NaN/Inf/negative texels, path", sc, path.clone(), 8, Check::Finite));
 
         let mut one = vec![[0.0f32; 3]; (w * h) as usize];
@@ -438,8 +589,22 @@ pub fn cases() -> Result<Vec<Case>, String> {
         let (env, _) = env_from_texels("one-texel", w, h, &one)?;
         let mut sc = builtin("furnace");
         sc.environment = env;
-        out.push(case("environment", "all power in one texel, importance", sc.clone(), mis.clone(), 256, Check::Finite));
-        out.push(case("environment", "all power in one texel, uniform", sc.clone(), Settings { env_sampling: EnvSampling::Uniform, ..mis.clone() }, 256, Check::SameAs { twin: "all power in one texel, importance".into(), rel_tol: 0.02 }));
+        out.push(case(
+            "environment",
+            "all power in one texel, importance",
+            sc.clone(),
+            mis.clone(),
+            256,
+            Check::Finite,
+        ));
+        out.push(case(
+            "environment",
+            "all power in one texel, uniform",
+            sc.clone(),
+            Settings { env_sampling: EnvSampling::Uniform, ..mis.clone() },
+            256,
+            Check::SameAs { twin: "all power in one texel, importance".into(), rel_tol: 0.02 },
+        ));
         out.push(case("environment", "all power in one texel, path", sc, path.clone(), 16, Check::Finite));
 
         let (env, _) = env_from_texels("zero", w, h, &vec![[0.0f32; 3]; (w * h) as usize])?;
@@ -452,16 +617,41 @@ pub fn cases() -> Result<Vec<Case>, String> {
     // Accumulation: 2^24 samples of a constant pixel; a pixel whose samples span 1e-6 … 1e6.
     {
         let st = Settings { width: 1, height: 1, strategy: Strategy::Bsdf, ..Settings::default() };
-        let mut c = case("accumulation", "2^24 samples of a constant pixel", emitter_wall(0.7), st, 1 << 24, Check::ExactEverywhere { value: 0.7f32 as f64, rel_tol: 1e-6 });
+        let mut c = case(
+            "accumulation",
+            "2^24 samples of a constant pixel",
+            emitter_wall(0.7),
+            st,
+            1 << 24,
+            Check::ExactEverywhere { value: 0.7f32 as f64, rel_tol: 1e-6 },
+        );
         c.dispatch_spp = Some(1 << 10);
         out.push(c);
 
         let mut sc = emitter_wall(1e6);
         sc.materials.push(Material::emitter("dim", Vec3::splat(1e-6)));
         // The right half of the view is the dim emitter, just in front of the bright one.
-        sc.quads.push(Quad { corner: Vec3::new(0.0, -1.0, 1e-3), edge_u: Vec3::new(1.0, 0.0, 0.0), edge_v: Vec3::new(0.0, 2.0, 0.0), material: 1 });
-        let st = Settings { width: 1, height: 1, strategy: Strategy::Bsdf, sampler: SamplerKind::Independent, ..Settings::default() };
-        let mut c = case("accumulation", "samples spanning 1e-6 … 1e6", sc, st, 1 << 16, Check::Mean { expected: 0.5 * (1e6 + 1e-6), rel_tol: 0.0 });
+        sc.quads.push(Quad {
+            corner: Vec3::new(0.0, -1.0, 1e-3),
+            edge_u: Vec3::new(1.0, 0.0, 0.0),
+            edge_v: Vec3::new(0.0, 2.0, 0.0),
+            material: 1,
+        });
+        let st = Settings {
+            width: 1,
+            height: 1,
+            strategy: Strategy::Bsdf,
+            sampler: SamplerKind::Independent,
+            ..Settings::default()
+        };
+        let mut c = case(
+            "accumulation",
+            "samples spanning 1e-6 … 1e6",
+            sc,
+            st,
+            1 << 16,
+            Check::Mean { expected: 0.5 * (1e6 + 1e-6), rel_tol: 0.0 },
+        );
         c.dispatch_spp = Some(1 << 10);
         out.push(c);
     }
@@ -476,7 +666,11 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
         .iter()
         .filter(|c| {
             filter.is_none_or(|f| {
-                c.name.contains(f) || c.group.contains(f) || all.iter().any(|o| o.name.contains(f) && matches!(&o.check, Check::SameAs { twin, .. } if *twin == c.name))
+                c.name.contains(f)
+                    || c.group.contains(f)
+                    || all.iter().any(|o| {
+                        o.name.contains(f) && matches!(&o.check, Check::SameAs { twin, .. } if *twin == c.name)
+                    })
             })
         })
         .collect();
@@ -492,7 +686,12 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
     Ok(outcomes)
 }
 
-fn run_case(ctx: &GpuContext, c: &Case, pipelines: &mut HashMap<crate::features::PipelineKey, wgpu::ComputePipeline>, means: &HashMap<String, (f64, f64)>) -> Result<Outcome, String> {
+fn run_case(
+    ctx: &GpuContext,
+    c: &Case,
+    pipelines: &mut HashMap<crate::features::PipelineKey, wgpu::ComputePipeline>,
+    means: &HashMap<String, (f64, f64)>,
+) -> Result<Outcome, String> {
     let data = SceneData::build(&c.scene);
     let gs = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", c.name))?;
     let mut r = Renderer::new_unprepared(ctx, &gs, c.scene.camera.clone(), c.settings.clone())?;
@@ -529,7 +728,17 @@ fn mean_and_error(film: &Film) -> (f64, f64) {
 
 fn judge(c: &Case, film: &Film, nonfinite: u64, seconds: f64, means: &HashMap<String, (f64, f64)>) -> Outcome {
     let (mean, se) = mean_and_error(film);
-    let mut o = Outcome { group: c.group, name: c.name.clone(), nonfinite, mean, std_error: se, expected: None, pass: true, detail: String::new(), seconds };
+    let mut o = Outcome {
+        group: c.group,
+        name: c.name.clone(),
+        nonfinite,
+        mean,
+        std_error: se,
+        expected: None,
+        pass: true,
+        detail: String::new(),
+        seconds,
+    };
     let fail = |o: &mut Outcome, why: String| {
         o.pass = false;
         if !o.detail.is_empty() {
@@ -545,15 +754,30 @@ fn judge(c: &Case, film: &Film, nonfinite: u64, seconds: f64, means: &HashMap<St
     }
     let missing = film.count.iter().zip(&film.nonfinite).filter(|(&n, &b)| n + b != c.spp).count();
     if missing > 0 {
-        let (lo, hi) = film.count.iter().zip(&film.nonfinite).map(|(&n, &b)| n + b).fold((u32::MAX, 0), |(lo, hi), n| (lo.min(n), hi.max(n)));
-        fail(&mut o, format!("{missing} pixels hold other than {} samples ({lo} … {hi}; a driver cut a loop short?)", c.spp));
+        let (lo, hi) = film
+            .count
+            .iter()
+            .zip(&film.nonfinite)
+            .map(|(&n, &b)| n + b)
+            .fold((u32::MAX, 0), |(lo, hi), n| (lo.min(n), hi.max(n)));
+        fail(
+            &mut o,
+            format!("{missing} pixels hold other than {} samples ({lo} … {hi}; a driver cut a loop short?)", c.spp),
+        );
     }
     let compare = |o: &mut Outcome, expected: f64, tol: f64, extra_se: f64| {
         o.expected = Some(expected);
         let allowed = tol * expected.abs() + 5.0 * (se * se + extra_se * extra_se).sqrt();
         let dev = mean - expected;
         if !(dev.abs() <= allowed) {
-            fail(o, format!("mean {mean:.6e} differs from {expected:.6e} by {:.2e} relative (allowed {:.2e})", dev / expected, allowed / expected.abs()));
+            fail(
+                o,
+                format!(
+                    "mean {mean:.6e} differs from {expected:.6e} by {:.2e} relative (allowed {:.2e})",
+                    dev / expected,
+                    allowed / expected.abs()
+                ),
+            );
         } else if o.detail.is_empty() {
             o.detail = format!("within {:.1e} relative", (dev / expected).abs());
         }
@@ -592,7 +816,9 @@ fn judge(c: &Case, film: &Film, nonfinite: u64, seconds: f64, means: &HashMap<St
 
 /// The outcomes as a Markdown table.
 pub fn table(outcomes: &[Outcome]) -> String {
-    let mut s = String::from("| group | case | NaN/Inf | mean | expected | s.e. | render s | result |\n|---|---|---|---|---|---|---|---|\n");
+    let mut s = String::from(
+        "| group | case | NaN/Inf | mean | expected | s.e. | render s | result |\n|---|---|---|---|---|---|---|---|\n",
+    );
     for o in outcomes {
         s.push_str(&format!(
             "| {} | {} | {} | {:.5e} | {} | {:.1e} | {:.2} | {} {} |\n",

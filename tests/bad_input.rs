@@ -56,7 +56,11 @@ fn manifest() -> Vec<Case> {
             continue;
         }
         let cols: Vec<&str> = line.split('\t').collect();
-        assert!(cols.len() >= 4, "MANIFEST.tsv line {}: expected file, mode, expect, substring[, args]: {line:?}", n + 1);
+        assert!(
+            cols.len() >= 4,
+            "MANIFEST.tsv line {}: expected file, mode, expect, substring[, args]: {line:?}",
+            n + 1
+        );
         let expect = match cols[2] {
             "error" => Expect::Error,
             "warning" => Expect::Warning,
@@ -69,7 +73,10 @@ fn manifest() -> Vec<Case> {
             other => panic!("MANIFEST.tsv line {}: unknown mode {other:?}", n + 1),
         };
         let line_no = n + 1;
-        assert!(expect != Expect::Error || !cols[3].is_empty(), "MANIFEST.tsv line {line_no}: an error case needs a substring");
+        assert!(
+            expect != Expect::Error || !cols[3].is_empty(),
+            "MANIFEST.tsv line {line_no}: an error case needs a substring"
+        );
         let args = cols.get(4).map(|a| a.split_whitespace().map(String::from).collect()).unwrap_or_default();
         cases.push(Case { file: cols[0].to_string(), env, expect, substring: cols[3].to_string(), args });
     }
@@ -168,7 +175,8 @@ fn check(case: &Case, scratch: &Path) -> Result<f64, String> {
             if o.code != Some(2) {
                 problems.push(format!("exit code {:?}, expected 2", o.code));
             }
-            let line = err.lines().find(|l| l.starts_with("error:") && l.contains(&name) && l.contains(&case.substring));
+            let line =
+                err.lines().find(|l| l.starts_with("error:") && l.contains(&name) && l.contains(&case.substring));
             if line.is_none() {
                 problems.push(format!("no `error:` line names `{name}` and says `{}`", case.substring));
             }
@@ -331,7 +339,8 @@ fn binding_size_check_names_the_buffer_and_the_limit() {
     // One texel more does not, and the message says which buffer, how large, and the limit.
     let data = SceneData { tex_texels: vec![0; (limit / 4) as usize + 1], ..Default::default() };
     let e = check_binding_sizes(&data, limit).unwrap_err();
-    for want in ["its texels need 1.0 MiB (1048580 bytes)", "max_storage_buffer_binding_size of 1 MiB (1048576 bytes)"] {
+    for want in ["its texels need 1.0 MiB (1048580 bytes)", "max_storage_buffer_binding_size of 1 MiB (1048576 bytes)"]
+    {
         assert!(e.contains(want), "{e}");
     }
     // Triangles: 16 bytes per vertex, three per triangle.

@@ -44,7 +44,9 @@ fn shared(rel: &str) -> PathBuf {
 
 #[test]
 fn every_builtin_renders_without_nan() {
-    for (scene, mode) in [("veach-mis", "direct"), ("cornell-box", "path"), ("furnace", "path"), ("area-vs-cosine", "direct")] {
+    for (scene, mode) in
+        [("veach-mis", "direct"), ("cornell-box", "path"), ("furnace", "path"), ("area-vs-cosine", "direct")]
+    {
         let out = tmp(&format!("{scene}.png"));
         let mut c = mislab();
         c.args(["render", scene, "--spp", "4", "--width", "64", "--height", "64", "--mode", mode, "-o"]).arg(&out);
@@ -77,7 +79,13 @@ fn assert_clean_failure(args: &[&str], scene: &Path, name_in_message: &str) {
     c.arg("render").arg(scene).args(args).args(["--spp", "1", "--width", "8", "--height", "8", "-o"]).arg(&out);
     let o = run(c, Duration::from_secs(60));
     let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{}: expected exit code 2, got {:?}:\n{err}", scene.display(), o.status.code());
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}: expected exit code 2, got {:?}:\n{err}",
+        scene.display(),
+        o.status.code()
+    );
     assert!(err.contains(name_in_message), "{}: the message must name '{name_in_message}':\n{err}", scene.display());
     assert!(!err.contains("panicked"), "{}: panicked:\n{err}", scene.display());
     assert!(!out.exists(), "a failed render must not leave an image behind");
@@ -160,7 +168,8 @@ fn interrupt_writes_what_has_accumulated() {
     let out = tmp("interrupted.png");
     let _ = std::fs::remove_file(&out);
     let mut c = mislab();
-    c.args(["render", "cornell-box", "--mode", "path", "--time", "120", "--width", "64", "--height", "64", "-o"]).arg(&out);
+    c.args(["render", "cornell-box", "--mode", "path", "--time", "120", "--width", "64", "--height", "64", "-o"])
+        .arg(&out);
     let mut child = c.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
     let pid = child.id();
     // Wait until rendering has started (start-up compiles the pipeline), then interrupt.

@@ -41,12 +41,24 @@ impl Config {
     /// A strategy with the CLI's default sub-choices (solid-angle light sampling, power heuristic, multi-sample MIS).
     fn of(strategy: Strategy) -> Config {
         let d = Settings::default();
-        Config { label: strategy.name().into(), strategy, light_sampling: d.light_sampling, heuristic: d.heuristic, mis: d.mis }
+        Config {
+            label: strategy.name().into(),
+            strategy,
+            light_sampling: d.light_sampling,
+            heuristic: d.heuristic,
+            mis: d.mis,
+        }
     }
 
     /// Applies the configuration to `base` (film size, mode, seed and sample counts stay).
     fn apply(&self, base: &Settings) -> Settings {
-        Settings { strategy: self.strategy, light_sampling: self.light_sampling, heuristic: self.heuristic, mis: self.mis, ..base.clone() }
+        Settings {
+            strategy: self.strategy,
+            light_sampling: self.light_sampling,
+            heuristic: self.heuristic,
+            mis: self.mis,
+            ..base.clone()
+        }
     }
 }
 
@@ -63,7 +75,12 @@ fn every_config() -> Vec<Config> {
             Strategy::Mis => {
                 for &k in MisKind::ALL {
                     for &h in Heuristic::ALL {
-                        v.push(Config { label: format!("mis/{}/{}", k.name(), h.name()), heuristic: h, mis: k, ..Config::of(s) });
+                        v.push(Config {
+                            label: format!("mis/{}/{}", k.name(), h.name()),
+                            heuristic: h,
+                            mis: k,
+                            ..Config::of(s)
+                        });
                     }
                 }
             }
@@ -97,7 +114,8 @@ struct Bench {
 impl Bench {
     fn new(scene: &Scene, width: u32, height: u32) -> Bench {
         let gs = GpuScene::upload(ctx(), SceneData::build(scene)).expect("upload");
-        let renderer = Renderer::new_unprepared(ctx(), &gs, scene.camera.clone(), small(width, height)).expect("renderer");
+        let renderer =
+            Renderer::new_unprepared(ctx(), &gs, scene.camera.clone(), small(width, height)).expect("renderer");
         Bench { renderer, camera: scene.camera.clone(), width, height }
     }
 
@@ -283,7 +301,10 @@ fn assert_agrees(what: &str, a: &Agreement, width: u32) {
     );
     let limit = sidak_z(ALPHA, AGGREGATE_TESTS);
     for (c, z) in a.aggregate_z.iter().enumerate() {
-        assert!(z.abs() < limit, "{what}: image mean differs from the reference in channel {c}: z = {z:.2} (limit {limit:.2})");
+        assert!(
+            z.abs() < limit,
+            "{what}: image mean differs from the reference in channel {c}: z = {z:.2} (limit {limit:.2})"
+        );
     }
 }
 
@@ -311,7 +332,12 @@ fn analytic_scene() -> Scene {
     s.materials.push(Material::emitter("sphere", Vec3::splat(L_SPHERE as f32)));
     s.materials.push(Material::emitter("quad", Vec3::splat(L_QUAD as f32)));
     // Plane y = 0, x ∈ [−3, 3], z ∈ [−2.5, 2.5]: edges +Z then +X, front +Y.
-    s.quads.push(Quad { corner: Vec3::new(-3.0, 0.0, -2.5), edge_u: Vec3::new(0.0, 0.0, 5.0), edge_v: Vec3::new(6.0, 0.0, 0.0), material: 0 });
+    s.quads.push(Quad {
+        corner: Vec3::new(-3.0, 0.0, -2.5),
+        edge_u: Vec3::new(0.0, 0.0, 5.0),
+        edge_v: Vec3::new(6.0, 0.0, 0.0),
+        material: 0,
+    });
     let c = DVec3::from(SPHERE_C).as_vec3();
     s.spheres.push(Sphere { center: c, radius: SPHERE_R as f32, material: 1 });
     // Edges +X then +Z: front −Y, towards the plane.
@@ -359,7 +385,8 @@ fn polygon_irradiance(p: DVec3, n: DVec3, verts: &[DVec3], l: f64) -> f64 {
 /// Radiance reflected by the Lambert plane at p towards any direction: ρ/π·(E_sphere + E_quad).
 fn plane_radiance(p: DVec3) -> f64 {
     let n = DVec3::Y;
-    let e = sphere_irradiance(p, n, DVec3::from(SPHERE_C), SPHERE_R, L_SPHERE) + polygon_irradiance(p, n, &quad_corners(), L_QUAD);
+    let e = sphere_irradiance(p, n, DVec3::from(SPHERE_C), SPHERE_R, L_SPHERE)
+        + polygon_irradiance(p, n, &quad_corners(), L_QUAD);
     RHO / std::f64::consts::PI * e
 }
 
@@ -380,7 +407,8 @@ fn quad_partly_hidden(p: DVec3) -> bool {
 
 /// The plane point a camera ray sees, or None when the ray meets a light first or misses the plane.
 fn analytic_visible_point(o: DVec3, d: DVec3) -> Option<DVec3> {
-    let (t_plane, _, _) = hit_parallelogram(o, d, DVec3::new(-3.0, 0.0, -2.5), DVec3::new(0.0, 0.0, 5.0), DVec3::new(6.0, 0.0, 0.0))?;
+    let (t_plane, _, _) =
+        hit_parallelogram(o, d, DVec3::new(-3.0, 0.0, -2.5), DVec3::new(0.0, 0.0, 5.0), DVec3::new(6.0, 0.0, 0.0))?;
     let [q0, q1, _, q3] = quad_corners();
     // The lights with a 2% margin so pixels grazing their silhouettes are left out.
     if hit_sphere(o, d, DVec3::from(SPHERE_C), SPHERE_R * 1.02).is_some_and(|t| t < t_plane) {
@@ -433,7 +461,9 @@ fn analytic_irradiance_formulas_match_quadrature() {
     let n = DVec3::Y;
     let c = DVec3::from(SPHERE_C);
     let quad = quad_corners();
-    for p in [DVec3::new(-1.3, 0.0, 0.0), DVec3::new(1.2, 0.0, 0.0), DVec3::new(0.3, 0.0, 1.1), DVec3::new(-2.5, 0.0, -1.9)] {
+    for p in
+        [DVec3::new(-1.3, 0.0, 0.0), DVec3::new(1.2, 0.0, 0.0), DVec3::new(0.3, 0.0, 1.1), DVec3::new(-2.5, 0.0, -1.9)]
+    {
         // Sphere: E = L ∫_cone (n·ω) dω, midpoint rule in (cosθ, φ) about the axis to the centre.
         let axis = (c - p).normalize();
         let (t1, t2) = axis.any_orthonormal_pair();
@@ -451,7 +481,10 @@ fn analytic_irradiance_formulas_match_quadrature() {
         }
         e_sphere *= (1.0 - cos_max) * std::f64::consts::TAU / (nu * nphi) as f64;
         let closed = sphere_irradiance(p, n, c, SPHERE_R, L_SPHERE);
-        assert!((e_sphere - closed).abs() < 1e-4 * closed, "sphere at {p}: quadrature {e_sphere} vs closed form {closed}");
+        assert!(
+            (e_sphere - closed).abs() < 1e-4 * closed,
+            "sphere at {p}: quadrature {e_sphere} vs closed form {closed}"
+        );
         // At the foot, the form.
         if p.x == SPHERE_C[0] && p.z == SPHERE_C[2] {
             let sin2 = (SPHERE_R / SPHERE_C[1]).powi(2);
@@ -472,7 +505,10 @@ fn analytic_irradiance_formulas_match_quadrature() {
             }
         }
         let closed = polygon_irradiance(p, n, &quad, L_QUAD);
-        assert!((e_quad - closed).abs() < 1e-4 * closed, "quad at {p}: quadrature {e_quad} vs Lambert's formula {closed}");
+        assert!(
+            (e_quad - closed).abs() < 1e-4 * closed,
+            "quad at {p}: quadrature {e_quad} vs Lambert's formula {closed}"
+        );
     }
 }
 
@@ -506,7 +542,9 @@ fn veach_plate_hit(o: DVec3, d: DVec3) -> Option<(usize, f64)> {
         }
     }
     let (t, k, x) = best?;
-    let occluded = VEACH_LIGHTS.iter().any(|(c, r, _)| hit_sphere(o, d, DVec3::from(c.map(f64::from)), *r as f64).is_some_and(|s| s < t));
+    let occluded = VEACH_LIGHTS
+        .iter()
+        .any(|(c, r, _)| hit_sphere(o, d, DVec3::from(c.map(f64::from)), *r as f64).is_some_and(|s| s < t));
     (!occluded).then_some((k, x))
 }
 
@@ -586,7 +624,10 @@ fn check_config(what: &str, bench: &mut Bench, reference: &Film, base: &Settings
             );
             let limit = sidak_z(ALPHA, AGGREGATE_TESTS);
             for (ch, z) in a.aggregate_z.iter().enumerate() {
-                assert!(z.abs() < limit, "{what}: image mean differs from the reference in channel {ch}: z = {z:.2} (limit {limit:.2})");
+                assert!(
+                    z.abs() < limit,
+                    "{what}: image mean differs from the reference in channel {ch}: z = {z:.2} (limit {limit:.2})"
+                );
             }
         }
     }
@@ -687,8 +728,17 @@ fn cornell_box_direct() {
     let mut bench = Bench::new(&sc, SCENE_SIZE, SCENE_SIZE);
     let base = small(SCENE_SIZE, SCENE_SIZE);
     let r = reference("cornell-box direct", &mut bench, &base, 1024);
-    let light = |ls: LightSampling| Config { label: format!("light/{}", ls.name()), light_sampling: ls, ..cfg(Strategy::Light) };
-    let one = Config { label: "mis/one/balance".into(), mis: MisKind::One, heuristic: Heuristic::Balance, ..cfg(Strategy::Mis) };
+    let light = |ls: LightSampling| Config {
+        label: format!("light/{}", ls.name()),
+        light_sampling: ls,
+        ..cfg(Strategy::Light)
+    };
+    let one = Config {
+        label: "mis/one/balance".into(),
+        mis: MisKind::One,
+        heuristic: Heuristic::Balance,
+        ..cfg(Strategy::Mis)
+    };
     for c in [light(LightSampling::SolidAngle), light(LightSampling::Area), cfg(Strategy::Mis), one] {
         check_config("cornell-box direct", &mut bench, &r, &base, &c, 256, Check::PerPixel(None));
     }
@@ -706,7 +756,12 @@ fn cornell_box_path() {
     let mut bench = Bench::new(&sc, SCENE_SIZE, SCENE_SIZE);
     let base = Settings { mode: Mode::Path, max_depth: PATH_DEPTH, ..small(SCENE_SIZE, SCENE_SIZE) };
     let r = reference("cornell-box path", &mut bench, &base, 512);
-    let one = Config { label: "mis/one/balance".into(), mis: MisKind::One, heuristic: Heuristic::Balance, ..cfg(Strategy::Mis) };
+    let one = Config {
+        label: "mis/one/balance".into(),
+        mis: MisKind::One,
+        heuristic: Heuristic::Balance,
+        ..cfg(Strategy::Mis)
+    };
     for c in [cfg(Strategy::Light), cfg(Strategy::Mis), one] {
         check_config("cornell-box path", &mut bench, &r, &base, &c, 256, Check::PerPixel(None));
     }
@@ -722,10 +777,16 @@ fn area_vs_cosine_direct() {
     let mut bench = Bench::new(&sc, SCENE_SIZE, SCENE_SIZE);
     let base = small(SCENE_SIZE, SCENE_SIZE);
     let r = reference("area-vs-cosine direct", &mut bench, &base, 2048);
-    let light = |ls: LightSampling| Config { label: format!("light/{}", ls.name()), light_sampling: ls, ..cfg(Strategy::Light) };
+    let light = |ls: LightSampling| Config {
+        label: format!("light/{}", ls.name()),
+        light_sampling: ls,
+        ..cfg(Strategy::Light)
+    };
     // Area sampling's r⁻² noise beside the light: at 256 spp 2 of 1024 pixels disagreed (the most the criterion
     // allows), at 1024 spp 1 (measured) — so 1024.
-    for (c, spp) in [(light(LightSampling::SolidAngle), 256), (light(LightSampling::Area), 1024), (cfg(Strategy::Mis), 256)] {
+    for (c, spp) in
+        [(light(LightSampling::SolidAngle), 256), (light(LightSampling::Area), 1024), (cfg(Strategy::Mis), 256)]
+    {
         check_config("area-vs-cosine direct", &mut bench, &r, &base, &c, spp, Check::PerPixel(None));
     }
     // Uniform sampling sees the low, wide light from the far floor with probability ≥ ~0.1% per sample (its
@@ -791,7 +852,15 @@ fn veach_mis_direct() {
     }
     let not_plates: Vec<bool> = veach_plate_pixels(&bench.camera, VEACH_SIZE, VEACH_SIZE).iter().map(|p| !p).collect();
     for c in every_config().iter().filter(|c| c.strategy == Strategy::Light) {
-        check_config("veach-mis direct, off the plates:", bench, reference, &base, c, 256, Check::PerPixel(Some(&not_plates)));
+        check_config(
+            "veach-mis direct, off the plates:",
+            bench,
+            reference,
+            &base,
+            c,
+            256,
+            Check::PerPixel(Some(&not_plates)),
+        );
     }
 }
 
@@ -803,7 +872,12 @@ fn veach_mis_path() {
     let mut bench = Bench::new(&sc, SCENE_SIZE, SCENE_SIZE);
     let base = Settings { mode: Mode::Path, max_depth: PATH_DEPTH, ..small(SCENE_SIZE, SCENE_SIZE) };
     let r = reference("veach-mis path", &mut bench, &base, 512);
-    let one = Config { label: "mis/one/balance".into(), mis: MisKind::One, heuristic: Heuristic::Balance, ..cfg(Strategy::Mis) };
+    let one = Config {
+        label: "mis/one/balance".into(),
+        mis: MisKind::One,
+        heuristic: Heuristic::Balance,
+        ..cfg(Strategy::Mis)
+    };
     for c in [cfg(Strategy::Mis), one] {
         check_config("veach-mis path", &mut bench, &r, &base, &c, 256, Check::PerPixel(None));
     }
@@ -823,7 +897,12 @@ const TABLE_SEEDS: u32 = 16;
 /// the small, very bright lights (probability ~1e-6, value ~100), so a region's mean squared error over a few
 /// thousand samples swings by 30× between batches of seeds (measured); a typical render's error is stable.
 /// Only the rows that show plates are rendered.
-fn region_rmse(v: &mut VeachDirect, settings: &Settings, regions: &[Option<(usize, usize)>], rows: (u32, u32)) -> [[f64; 4]; 4] {
+fn region_rmse(
+    v: &mut VeachDirect,
+    settings: &Settings,
+    regions: &[Option<(usize, usize)>],
+    rows: (u32, u32),
+) -> [[f64; 4]; 4] {
     let chan_mean = |c: [f32; 3]| c.iter().map(|&x| x as f64).sum::<f64>() / 3.0;
     let mut var_r = [[0.0f64; 4]; 4];
     let mut n = [[0usize; 4]; 4];
@@ -919,9 +998,20 @@ fn veach_mis_power_heuristic_is_never_much_worse_than_the_better_technique() {
                 100.0 * relative
             );
             if !(ratio <= 1.1 || relative <= 0.1) {
-                failures.push(format!("plate {} × light {}: power {:.4} vs better {:.4} (×{ratio:.2}, {:.1}% of the mean)", p + 1, c + 1, power[p][c], better, 100.0 * relative));
+                failures.push(format!(
+                    "plate {} × light {}: power {:.4} vs better {:.4} (×{ratio:.2}, {:.1}% of the mean)",
+                    p + 1,
+                    c + 1,
+                    power[p][c],
+                    better,
+                    100.0 * relative
+                ));
             }
         }
     }
-    assert!(failures.is_empty(), "the power heuristic is more than 1.1× worse than the better technique in: {}", failures.join("; "));
+    assert!(
+        failures.is_empty(),
+        "the power heuristic is more than 1.1× worse than the better technique in: {}",
+        failures.join("; ")
+    );
 }

@@ -49,6 +49,12 @@ fn committed_fuzz_corpus_never_panics() {
     let failures: Vec<String> = inputs.iter().filter_map(|p| replay(p, &dir).err()).collect();
     let _ = std::panic::take_hook();
     let _ = std::fs::remove_dir_all(&dir);
-    assert!(failures.is_empty(), "{} of {} corpus inputs failed:\n{}", failures.len(), inputs.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} of {} corpus inputs failed:\n{}",
+        failures.len(),
+        inputs.len(),
+        failures.join("\n")
+    );
     eprintln!("{} corpus inputs replayed: no panic, every error names its file", inputs.len());
 }

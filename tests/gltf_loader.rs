@@ -555,7 +555,9 @@ fn repaired_content_of_the_robustness_files() {
     assert_eq!(bad_normals.triangle_count(), 12);
     assert_mesh_sane(&bad_normals.meshes[0], Path::new("BoxBadNormals"));
     // Every position has an infinite x: corrupt data is refused, naming the vertex.
-    let infinites = load_no_panic(Path::new(&format!("{TESTDATA}/robustness/assimp/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb")));
+    let infinites = load_no_panic(Path::new(&format!(
+        "{TESTDATA}/robustness/assimp/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb"
+    )));
     let e = infinites.expect_err("a NaN/Inf position must be an error");
     assert!(e.contains("BoxWithInfinites.glb") && e.contains("non-finite vertex position: vertex 0"), "{e}");
 }
@@ -802,14 +804,17 @@ fn non_finite_vertices_are_refused_when_used_and_normals_generated() {
         v["buffers"][0] = parse(&format!(r#"{{"byteLength": {}}}"#, bytes.len()));
         v["buffers"][0]["uri"] = b64(&bytes).into();
         let ib = 2 * indices.len();
-        v["bufferViews"] = parse(&format!(r#"[{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": {ib}}}]"#));
+        v["bufferViews"] = parse(&format!(
+            r#"[{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": {ib}}}]"#
+        ));
         v["accessors"][0]["count"] = 4.into();
         v["accessors"][1]["count"] = indices.len().into();
         v["meshes"][0]["primitives"][0]["attributes"] = parse(r#"{"POSITION": 0}"#);
         v
     };
     // A triangle uses the NaN vertex: corrupt data, refused with the vertex named.
-    let e = load_no_panic(&write_json(&dir, "nan.gltf", &gltf_with(&[0, 1, 2, 1, 3, 2]))).expect_err("NaN position in use");
+    let e =
+        load_no_panic(&write_json(&dir, "nan.gltf", &gltf_with(&[0, 1, 2, 1, 3, 2]))).expect_err("NaN position in use");
     assert!(e.contains("nan.gltf") && e.contains("non-finite vertex position: vertex 3 is (NaN, 0, 0)"), "{e}");
     // No triangle uses it: nothing to refuse; the normals are generated from the geometry.
     let s = load_no_panic(&write_json(&dir, "unused.gltf", &gltf_with(&[0, 1, 2]))).unwrap();

@@ -42,17 +42,81 @@ fn shared_structs_match() {
     check!(m, "Sphere", GpuSphere, [center, radius, material, light, _pad0, _pad1]);
     check!(m, "Quad", GpuQuad, [corner, material, edge_u, light, edge_v, _pad0]);
     check!(m, "TriShading", GpuTriShading, [n0, material, n1, light, n2, _pad0, uv0, uv1, uv2, _pad1]);
-    check!(m, "Material", GpuMaterial, [base_color, metallic, emission, alpha, specular, base_tex, mr_tex, emissive_tex,
-        base_xform0, base_xform1, mr_xform0, mr_xform1, em_xform0, em_xform1]);
-    check!(m, "Light", GpuLight, [position, kind, direction, prim, radiance, pmf_power, cos_inner, cos_outer, area, pmf_uniform]);
+    check!(
+        m,
+        "Material",
+        GpuMaterial,
+        [
+            base_color,
+            metallic,
+            emission,
+            alpha,
+            specular,
+            base_tex,
+            mr_tex,
+            emissive_tex,
+            base_xform0,
+            base_xform1,
+            mr_xform0,
+            mr_xform1,
+            em_xform0,
+            em_xform1
+        ]
+    );
+    check!(
+        m,
+        "Light",
+        GpuLight,
+        [position, kind, direction, prim, radiance, pmf_power, cos_inner, cos_outer, area, pmf_uniform]
+    );
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
     check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, _pad0]);
     check!(m, "Accum", GpuAccum, [mean, count, m2, nonfinite]);
-    check!(m, "FrameParams", GpuFrameParams, [width, height, sample_base, samples_per_dispatch, seed, mode, max_depth,
-        strategy, light_sampling, env_sampling, light_select, heuristic, power_beta, light_samples, bsdf_samples,
-        mis_kind, sampler, num_lights, rr_depth, env_light, cam_origin, tan_half_fov, cam_right, aspect, cam_up,
-        env_scale, cam_forward, env_rotation, env_constant, env_width, env_height, sampler_spp, row_offset, row_count,
-        offset_scale, _pad0, _pad1, _pad2]);
+    check!(
+        m,
+        "FrameParams",
+        GpuFrameParams,
+        [
+            width,
+            height,
+            sample_base,
+            samples_per_dispatch,
+            seed,
+            mode,
+            max_depth,
+            strategy,
+            light_sampling,
+            env_sampling,
+            light_select,
+            heuristic,
+            power_beta,
+            light_samples,
+            bsdf_samples,
+            mis_kind,
+            sampler,
+            num_lights,
+            rr_depth,
+            env_light,
+            cam_origin,
+            tan_half_fov,
+            cam_right,
+            aspect,
+            cam_up,
+            env_scale,
+            cam_forward,
+            env_rotation,
+            env_constant,
+            env_width,
+            env_height,
+            sampler_spp,
+            row_offset,
+            row_count,
+            offset_scale,
+            _pad0,
+            _pad1,
+            _pad2
+        ]
+    );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
     check!(m, "BvhNode", GpuBvhNode, [lmin, l_first, lmax, l_count, rmin, r_first, rmax, r_count]);
 }
@@ -95,12 +159,22 @@ fn tag_constants_match() {
     check_enum!(m, MisKind);
     check_enum!(m, SamplerKind);
     for (name, v) in [
-        ("PRIM_TRIANGLE", PRIM_TRIANGLE), ("PRIM_SPHERE", PRIM_SPHERE), ("PRIM_QUAD", PRIM_QUAD),
-        ("PRIM_KIND_SHIFT", PRIM_KIND_SHIFT), ("PRIM_INDEX_MASK", PRIM_INDEX_MASK),
-        ("LIGHT_TRIANGLE", LIGHT_TRIANGLE), ("LIGHT_SPHERE", LIGHT_SPHERE), ("LIGHT_QUAD", LIGHT_QUAD),
-        ("LIGHT_POINT", LIGHT_POINT), ("LIGHT_SPOT", LIGHT_SPOT), ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
-        ("LIGHT_ENVIRONMENT", LIGHT_ENVIRONMENT), ("WRAP_REPEAT", WRAP_REPEAT), ("WRAP_CLAMP", WRAP_CLAMP),
-        ("WRAP_MIRROR", WRAP_MIRROR), ("INVALID", INVALID),
+        ("PRIM_TRIANGLE", PRIM_TRIANGLE),
+        ("PRIM_SPHERE", PRIM_SPHERE),
+        ("PRIM_QUAD", PRIM_QUAD),
+        ("PRIM_KIND_SHIFT", PRIM_KIND_SHIFT),
+        ("PRIM_INDEX_MASK", PRIM_INDEX_MASK),
+        ("LIGHT_TRIANGLE", LIGHT_TRIANGLE),
+        ("LIGHT_SPHERE", LIGHT_SPHERE),
+        ("LIGHT_QUAD", LIGHT_QUAD),
+        ("LIGHT_POINT", LIGHT_POINT),
+        ("LIGHT_SPOT", LIGHT_SPOT),
+        ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
+        ("LIGHT_ENVIRONMENT", LIGHT_ENVIRONMENT),
+        ("WRAP_REPEAT", WRAP_REPEAT),
+        ("WRAP_CLAMP", WRAP_CLAMP),
+        ("WRAP_MIRROR", WRAP_MIRROR),
+        ("INVALID", INVALID),
     ] {
         assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");
     }

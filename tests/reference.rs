@@ -45,7 +45,10 @@ fn check(scene_name: &str, mode: Mode, spp: u32, reference_file: &str, limit: f6
     eprintln!("{scene_name} {mode:?}: relMSE {raw:.3e} (our noise {noise:.3e}) → systematic {debiased:.3e}, limit {limit:.1e}");
     assert!(debiased < limit, "{scene_name} {mode:?}: systematic relMSE {debiased:.3e} ≥ {limit:.1e} against Mitsuba");
     // The noise estimate must not swamp the test: otherwise it could pass by luck.
-    assert!(noise < noise_factor * limit, "{scene_name}: too few samples for a meaningful comparison (noise {noise:.2e})");
+    assert!(
+        noise < noise_factor * limit,
+        "{scene_name}: too few samples for a meaningful comparison (noise {noise:.2e})"
+    );
 }
 
 #[test]

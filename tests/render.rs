@@ -26,12 +26,18 @@ fn furnace_is_one(mode: Mode, strategy: Strategy) {
             // A zero-variance pixel must be exactly right (up to f32 rounding of the mean).
             let sd = var[c].sqrt().max(1e-6);
             let z = (x - 1.0) / sd;
-            assert!(z.abs() < z_max, "{mode:?}/{strategy:?}: pixel {i} channel {c} = {x} (z = {z:.2}, limit {z_max:.2})");
+            assert!(
+                z.abs() < z_max,
+                "{mode:?}/{strategy:?}: pixel {i} channel {c} = {x} (z = {z:.2}, limit {z_max:.2})"
+            );
         }
     }
     let mean = sum / (3 * n) as f64;
     let sigma = var_sum.sqrt() / (3 * n) as f64;
-    assert!((mean - 1.0).abs() < 3.0 * sigma.max(1e-6), "{mode:?}/{strategy:?}: image mean {mean} vs 1 (σ = {sigma:e})");
+    assert!(
+        (mean - 1.0).abs() < 3.0 * sigma.max(1e-6),
+        "{mode:?}/{strategy:?}: image mean {mean} vs 1 (σ = {sigma:e})"
+    );
 }
 
 #[test]
@@ -126,8 +132,14 @@ fn large_requests_keep_every_sample() {
     let ctx = gpu();
     let scene = scene("cornell-box");
     let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::gpu_scene::SceneData::build(&scene)).unwrap();
-    let mut r = mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), Settings { mode: Mode::Path, ..small(8, 8) }).unwrap();
+    let mut r =
+        mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), Settings { mode: Mode::Path, ..small(8, 8) })
+            .unwrap();
     r.render(&ctx, 512).unwrap();
     let film = r.film(&ctx).unwrap();
-    assert!(film.count.iter().zip(&film.nonfinite).all(|(c, b)| c + b == 512), "samples were dropped: {:?}", &film.count[..4]);
+    assert!(
+        film.count.iter().zip(&film.nonfinite).all(|(c, b)| c + b == 512),
+        "samples were dropped: {:?}",
+        &film.count[..4]
+    );
 }

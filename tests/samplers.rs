@@ -19,7 +19,11 @@ use mislab::shaders;
 fn wgsl_constants_match_rust() {
     let module = shaders::validate(&shaders::compose(mislab::render::RENDER_FILES, "")).expect("render module");
     let value = |name: &str| -> u32 {
-        let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("no WGSL const {name}"));
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no WGSL const {name}"));
         match module.global_expressions[c.init] {
             naga::Expression::Literal(naga::Literal::U32(v)) => v,
             ref e => panic!("{name}: unexpected initializer {e:?}"),
@@ -79,8 +83,14 @@ fn sobol_matrices_have_optimal_2d_projections() {
             assert_eq!(sobol_bits(i, d, sampler_data()), sobol_bits_matrix(i, &m[d as usize]), "dim {d} index {i}");
         }
     }
-    println!("Sobol t-values at m = 10: (0,2) {}, (1,2) {}, (0,3) {}, (1,3) {}, (2,3) {}",
-        t_value_2d(&m[0], &m[2], 10), t_value_2d(&m[1], &m[2], 10), t_value_2d(&m[0], &m[3], 10), t_value_2d(&m[1], &m[3], 10), t_value_2d(&m[2], &m[3], 10));
+    println!(
+        "Sobol t-values at m = 10: (0,2) {}, (1,2) {}, (0,3) {}, (1,3) {}, (2,3) {}",
+        t_value_2d(&m[0], &m[2], 10),
+        t_value_2d(&m[1], &m[2], 10),
+        t_value_2d(&m[0], &m[3], 10),
+        t_value_2d(&m[1], &m[3], 10),
+        t_value_2d(&m[2], &m[3], 10)
+    );
 }
 
 #[test]
@@ -209,7 +219,16 @@ fn workgroups(threads: u32) -> [u32; 3] {
 }
 
 /// Points of `pixels` consecutive pixels from `first_pixel`, `samples` each, on the device.
-fn device_points(ctx: &mislab::gpu::GpuContext, kind: SamplerKind, seed: u32, spp_target: u32, width: u32, first_pixel: u32, pixels: u32, samples: u32) -> Vec<f32> {
+fn device_points(
+    ctx: &mislab::gpu::GpuContext,
+    kind: SamplerKind,
+    seed: u32,
+    spp_target: u32,
+    width: u32,
+    first_pixel: u32,
+    pixels: u32,
+    samples: u32,
+) -> Vec<f32> {
     let cfg = [seed, spp_target, width, samples, pixels, first_pixel];
     let n = (pixels * samples) as usize;
     let bytes = Probe::new(ctx)
@@ -227,7 +246,15 @@ fn device_points(ctx: &mislab::gpu::GpuContext, kind: SamplerKind, seed: u32, sp
 }
 
 /// The same points from the CPU twins.
-fn cpu_points(kind: SamplerKind, seed: u32, spp_target: u32, width: u32, first_pixel: u32, pixels: u32, samples: u32) -> Vec<f32> {
+fn cpu_points(
+    kind: SamplerKind,
+    seed: u32,
+    spp_target: u32,
+    width: u32,
+    first_pixel: u32,
+    pixels: u32,
+    samples: u32,
+) -> Vec<f32> {
     let p = SamplerParams { kind, seed, sampler_spp: spp_target, width };
     let mut out = Vec::with_capacity((pixels * samples) as usize * PER_POINT);
     for px in first_pixel..first_pixel + pixels {
@@ -278,8 +305,12 @@ fn device_matches_cpu_and_projections_are_uniform() {
             assert_eq!(dev.len(), cpu.len());
             let mismatches = dev.iter().zip(&cpu).filter(|(a, b)| (**a - **b).abs() > 1.0 / (1 << 20) as f32).count();
             let first_bad = dev.iter().zip(&cpu).position(|(a, b)| (*a - *b).abs() > 1.0 / (1 << 20) as f32);
-            assert_eq!(mismatches, 0, "{kind}: {mismatches} device values differ from the CPU twin (first at {first_bad:?}: {:?})",
-                first_bad.map(|i| (dev[i], cpu[i], i / PER_POINT, i % PER_POINT)));
+            assert_eq!(
+                mismatches,
+                0,
+                "{kind}: {mismatches} device values differ from the CPU twin (first at {first_bad:?}: {:?})",
+                first_bad.map(|i| (dev[i], cpu[i], i / PER_POINT, i % PER_POINT))
+            );
             let point = |t: usize, k: usize| dev[t * PER_POINT + k];
             let n = (pixels * samples) as usize;
             let mut check = |name: String, a: usize, b: usize| {
@@ -287,7 +318,10 @@ fn device_matches_cpu_and_projections_are_uniform() {
                 if p < worst.0 {
                     worst = (p, format!("{name}: χ² = {stat:.1}, p = {p:.2e}"));
                 }
-                assert!(p > alpha, "{kind} ({pixels} px × {samples} spp) {name}: χ² = {stat:.1} (255 dof), p = {p:.2e} < {alpha:.1e}");
+                assert!(
+                    p > alpha,
+                    "{kind} ({pixels} px × {samples} spp) {name}: χ² = {stat:.1} (255 dof), p = {p:.2e} < {alpha:.1e}"
+                );
             };
             for &(a, b) in &pairs {
                 check(format!("dims ({a}, {b})"), a, b);
@@ -379,7 +413,10 @@ fn randomized_sequences_are_unbiased_over_seeds() {
             let se = (var / v.len() as f64).sqrt().max(1e-9);
             let z = (mean - truth) / se;
             println!("{kind:>12} integrand {k}: mean over {seeds} seeds {mean:.6} (exact {truth:.6}, z = {z:+.2})");
-            assert!(z.abs() < z_max, "{kind}: integrand {k} has mean {mean} over seeds, exact {truth} (z = {z:.2}, limit {z_max:.2})");
+            assert!(
+                z.abs() < z_max,
+                "{kind}: integrand {k} has mean {mean} over seeds, exact {truth} (z = {z:.2}, limit {z_max:.2})"
+            );
         }
     }
 }
@@ -464,8 +501,14 @@ fn convergence_slopes_on_smooth_pixel_integrands() {
                     b += ((v[0] * v[1]) as f64).exp();
                 }
                 let k = 2 * (p as usize * LADDER.len() + l);
-                assert!((est[k] as f64 - a / n as f64).abs() < 1e-4 && (est[k + 1] as f64 - b / n as f64).abs() < 1e-4,
-                    "{kind}: pixel {p}, N = {n}: device ({}, {}) vs CPU ({}, {})", est[k], est[k + 1], a / n as f64, b / n as f64);
+                assert!(
+                    (est[k] as f64 - a / n as f64).abs() < 1e-4 && (est[k + 1] as f64 - b / n as f64).abs() < 1e-4,
+                    "{kind}: pixel {p}, N = {n}: device ({}, {}) vs CPU ({}, {})",
+                    est[k],
+                    est[k + 1],
+                    a / n as f64,
+                    b / n as f64
+                );
             }
         }
         let mut slopes = [0.0; 2];
@@ -473,7 +516,9 @@ fn convergence_slopes_on_smooth_pixel_integrands() {
         for (k, slope) in slopes.iter_mut().enumerate() {
             let rmse: Vec<f64> = (0..LADDER.len())
                 .map(|l| {
-                    let se: f64 = (0..pixels as usize).map(|p| (est[2 * (p * LADDER.len() + l) + k] as f64 - exact).powi(2)).sum();
+                    let se: f64 = (0..pixels as usize)
+                        .map(|p| (est[2 * (p * LADDER.len() + l) + k] as f64 - exact).powi(2))
+                        .sum();
                     (se / pixels as f64).sqrt()
                 })
                 .collect();
@@ -526,7 +571,6 @@ fn every_sampler_renders_the_furnace() {
         assert!((mean - 1.0).abs() < 4.0 * sigma.max(1e-4), "{kind}: furnace mean {mean} (σ {sigma:.1e})");
     }
 }
-
 
 /// lavapipe (Mesa 22.3 gallivm) gives each invocation one budget of 65535 loop iterations, shared by every
 /// loop it runs, and silently stops looping when it is spent. The samplers therefore avoid loops (table
@@ -644,14 +688,42 @@ fn bench_end_to_end_from_flags() {
     let dir = scratch("bench");
     let out = dir.to_string_lossy().into_owned();
     let cli = BenchCli::parse_from([
-        "bench", "veach-mis", "--width", "24", "--height", "16", "--samplers", "independent,stratified", "--spp", "1,4,16",
-        "--seeds", "2", "--ref-spp", "256", "--out", &out,
+        "bench",
+        "veach-mis",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--samplers",
+        "independent,stratified",
+        "--spp",
+        "1,4,16",
+        "--seeds",
+        "2",
+        "--ref-spp",
+        "256",
+        "--out",
+        &out,
     ]);
     mislab::bench::run(&cli.args).unwrap();
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    for col in ["scene", "mode", "strategy", "sampler", "heuristic", "spp", "seed", "seconds_gpu", "seconds_wall", "rmse", "relmse", "mae", "efficiency"] {
+    for col in [
+        "scene",
+        "mode",
+        "strategy",
+        "sampler",
+        "heuristic",
+        "spp",
+        "seed",
+        "seconds_gpu",
+        "seconds_wall",
+        "rmse",
+        "relmse",
+        "mae",
+        "efficiency",
+    ] {
         assert!(header.contains(&col), "results.csv lacks column {col}");
     }
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
@@ -663,13 +735,22 @@ fn bench_end_to_end_from_flags() {
         assert!(rel > 0.0 && rel.is_finite() && t > 0.0, "row {r:?}");
     }
     let mean_rel = |spp: &str| {
-        let v: Vec<f64> = rows.iter().filter(|r| r[col("spp")] == spp).map(|r| r[col("relmse")].parse::<f64>().unwrap()).collect();
+        let v: Vec<f64> =
+            rows.iter().filter(|r| r[col("spp")] == spp).map(|r| r[col("relmse")].parse::<f64>().unwrap()).collect();
         v.iter().sum::<f64>() / v.len() as f64
     };
     assert!(mean_rel("16") < mean_rel("1"), "error must fall with spp");
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
     assert_eq!(json["rows"].as_array().unwrap().len(), 12);
-    for f in ["summary.md", "veach-mis-direct-error-vs-time.png", "veach-mis-direct-error-vs-time.svg", "veach-mis-direct-error-vs-spp.png", "veach-mis-direct-heatmaps.png", "veach-mis-direct-heatmaps.svg"] {
+    for f in [
+        "summary.md",
+        "veach-mis-direct-error-vs-time.png",
+        "veach-mis-direct-error-vs-time.svg",
+        "veach-mis-direct-error-vs-spp.png",
+        "veach-mis-direct-heatmaps.png",
+        "veach-mis-direct-heatmaps.svg",
+    ] {
         assert!(dir.join(f).exists(), "{f} missing");
     }
     assert!(std::fs::read_dir(dir.join("refs")).unwrap().count() == 1, "the reference is cached");
@@ -692,7 +773,9 @@ fn bench_from_toml() {
     let csv = std::fs::read_to_string(dir.join("out/results.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 2 * 2 + 2, "{csv}");
     assert!(csv.contains("heuristics,balance") && csv.contains("cornell path,sobol"));
-    assert!(BenchCli::try_parse_from(["bench", "--suite", "lecture", "--config", &cfg]).map(|c| c.args.groups().is_err()).unwrap_or(true));
+    assert!(BenchCli::try_parse_from(["bench", "--suite", "lecture", "--config", &cfg])
+        .map(|c| c.args.groups().is_err())
+        .unwrap_or(true));
 }
 
 /// The lecture suite, end to end (about half an hour on a loaded 2-core lavapipe machine;
@@ -705,7 +788,11 @@ fn lecture_suite_end_to_end() {
     use clap::Parser;
     let out = std::env::var("MISLAB_SUITE_OUT").unwrap_or_else(|_| scratch("suite").to_string_lossy().into_owned());
     let extra = std::env::var("MISLAB_BENCH_ARGS").unwrap_or_else(|_| "--suite lecture".into());
-    let args: Vec<String> = ["bench".to_string()].into_iter().chain(extra.split_whitespace().map(String::from)).chain(["--out".into(), out.clone()]).collect();
+    let args: Vec<String> = ["bench".to_string()]
+        .into_iter()
+        .chain(extra.split_whitespace().map(String::from))
+        .chain(["--out".into(), out.clone()])
+        .collect();
     let cli = BenchCli::parse_from(args);
     mislab::bench::run(&cli.args).unwrap();
     assert!(std::path::Path::new(&out).join("results.csv").exists());

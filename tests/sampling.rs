@@ -275,11 +275,15 @@ fn layout_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLay
 
 impl Harness {
     fn new() -> Harness {
-        let ctx = GpuContext::new().expect("the sampling tests need a Vulkan adapter (install mesa-vulkan-drivers for lavapipe)");
+        let ctx = GpuContext::new()
+            .expect("the sampling tests need a Vulkan adapter (install mesa-vulkan-drivers for lavapipe)");
         let device = &ctx.device;
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
         let scene_entries: Vec<_> = (0..13).map(|b| layout_entry(b, ro)).collect();
-        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("probe scene"), entries: &scene_entries });
+        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("probe scene"),
+            entries: &scene_entries,
+        });
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe frame"),
             entries: &[layout_entry(0, wgpu::BufferBindingType::Uniform)],
@@ -298,8 +302,11 @@ impl Harness {
             immediate_size: 0,
         });
         let source = probe_source();
-        let sample = mislab::shaders::compute_pipeline(device, "probe_sample", &source, "probe_sample", &[], Some(&layout)).unwrap();
-        let pdf = mislab::shaders::compute_pipeline(device, "probe_pdf", &source, "probe_pdf", &[], Some(&layout)).unwrap();
+        let sample =
+            mislab::shaders::compute_pipeline(device, "probe_sample", &source, "probe_sample", &[], Some(&layout))
+                .unwrap();
+        let pdf =
+            mislab::shaders::compute_pipeline(device, "probe_pdf", &source, "probe_pdf", &[], Some(&layout)).unwrap();
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("probe params"),
             size: std::mem::size_of::<GpuFrameParams>() as u64,
@@ -315,9 +322,17 @@ impl Harness {
             .into_iter()
             .map(|s| {
                 let scene = GpuScene::upload(&ctx, SceneData::build(&s)).expect("upload");
-                let entries: Vec<_> =
-                    scene.buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-                let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("probe scene"), layout: &scene_layout, entries: &entries });
+                let entries: Vec<_> = scene
+                    .buffers
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                    .collect();
+                let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("probe scene"),
+                    layout: &scene_layout,
+                    entries: &entries,
+                });
                 Bound { scene, group }
             })
             .collect();
@@ -329,7 +344,15 @@ impl Harness {
     }
 
     /// One dispatch of `job.count` invocations; returns `out_len` vec4 of output.
-    fn dispatch(&self, pdf: bool, scene: SceneId, frame: &GpuFrameParams, job: &ProbeJob, input: &[[f32; 4]], out_len: usize) -> Vec<[f32; 4]> {
+    fn dispatch(
+        &self,
+        pdf: bool,
+        scene: SceneId,
+        frame: &GpuFrameParams,
+        job: &ProbeJob,
+        input: &[[f32; 4]],
+        out_len: usize,
+    ) -> Vec<[f32; 4]> {
         let _guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
         let device = &self.ctx.device;
         self.ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(frame));
@@ -358,7 +381,8 @@ impl Harness {
         let gx = groups.min(65535);
         let mut enc = device.create_command_encoder(&Default::default());
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probe"), timestamp_writes: None });
+            let mut pass =
+                enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probe"), timestamp_writes: None });
             pass.set_pipeline(if pdf { &self.pdf } else { &self.sample });
             pass.set_bind_group(0, &self.scenes[scene as usize].group, &[]);
             pass.set_bind_group(1, &self.frame_group, &[]);
@@ -483,8 +507,17 @@ fn lights_scene() -> Scene {
             Material::emitter("warm", Vec3::new(5.0, 3.0, 1.0)),
             Material::emitter("dim", Vec3::splat(0.2)),
         ],
-        meshes: vec![Mesh { name: "tri".into(), positions: t.iter().map(|&p| v(p)).collect(), indices: vec![[0, 1, 2]], material: 0, ..Default::default() }],
-        quads: vec![Quad { corner: v(rc), edge_u: v(ru), edge_v: v(rv), material: 0 }, Quad { corner: v(pc), edge_u: v(pu), edge_v: v(pv), material: 1 }],
+        meshes: vec![Mesh {
+            name: "tri".into(),
+            positions: t.iter().map(|&p| v(p)).collect(),
+            indices: vec![[0, 1, 2]],
+            material: 0,
+            ..Default::default()
+        }],
+        quads: vec![
+            Quad { corner: v(rc), edge_u: v(ru), edge_v: v(rv), material: 0 },
+            Quad { corner: v(pc), edge_u: v(pu), edge_v: v(pv), material: 1 },
+        ],
         spheres: vec![
             Sphere { center: v(SPHERE_C), radius: SPHERE_R, material: 0 },
             Sphere { center: v(TINY_C), radius: TINY_R, material: 2 },
@@ -497,7 +530,11 @@ fn lights_scene() -> Scene {
 
 fn env_scene(map: EnvMap) -> Scene {
     let rotation = if map.width == 20 { 0.3 } else { 0.0 };
-    Scene { name: "sampling-env".into(), environment: Environment::Map { map: std::sync::Arc::new(map), scale: 1.0, rotation }, ..Default::default() }
+    Scene {
+        name: "sampling-env".into(),
+        environment: Environment::Map { map: std::sync::Arc::new(map), scale: 1.0, rotation },
+        ..Default::default()
+    }
 }
 
 /// 20×10, black but for texel (7, 2).
@@ -509,7 +546,8 @@ fn pixel_map() -> EnvMap {
 
 /// 3×2 with a 1:1000 range and one black texel.
 fn map_3x2() -> EnvMap {
-    let texels = vec![[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [10.0, 2.0, 0.5], [0.01, 0.02, 0.01], [3.0, 3.0, 3.0], [0.5, 0.1, 0.9]];
+    let texels =
+        vec![[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [10.0, 2.0, 0.5], [0.01, 0.02, 0.01], [3.0, 3.0, 3.0], [0.5, 0.1, 0.9]];
     EnvMap { path: "3x2".into(), width: 3, height: 2, texels }
 }
 
@@ -522,7 +560,8 @@ fn hdr_map() -> EnvMap {
 /// Index in the light table of the light of `kind` with primitive index `prim`.
 fn light_index(kind: u32, prim: u32) -> u32 {
     let d = harness().data(SceneId::Lights);
-    d.lights.iter().position(|l| l.kind == kind && l.prim == prim).unwrap_or_else(|| panic!("no light {kind}/{prim}")) as u32
+    d.lights.iter().position(|l| l.kind == kind && l.prim == prim).unwrap_or_else(|| panic!("no light {kind}/{prim}"))
+        as u32
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -681,7 +720,8 @@ fn run_case(c: &Case) -> Row {
             }
         })
         .collect();
-    let mut options = Chi2Options { may_fail: c.may_fail, alpha: alpha(), base: c.base, refine: c.refine, ..Default::default() };
+    let mut options =
+        Chi2Options { may_fail: c.may_fail, alpha: alpha(), base: c.base, refine: c.refine, ..Default::default() };
     let mut pdf = |pts: &[DVec3]| -> Vec<f64> {
         let (inputs, jac): (Vec<[[f32; 4]; 2]>, Vec<f64>) = pts.iter().map(|&w| (c.pdf_input)(w)).unzip();
         h.pdf(&c.setup, &inputs).iter().zip(jac).map(|(p, j)| p * j).collect()
@@ -694,7 +734,14 @@ fn run_case(c: &Case) -> Row {
         Dom::Env(d) => Chi2Test { name: c.name.clone(), domain: d, options }.run(&samples, &mut pdf),
         Dom::Window(d) => Chi2Test { name: c.name.clone(), domain: d, options }.run(&samples, &mut pdf),
     };
-    Row { report, config: c.config.clone(), pdf_mismatch: mismatch, pdf_outliers: outliers as f64 / N as f64, pdf_match: c.pdf_match, seconds: t0.elapsed().as_secs_f64() }
+    Row {
+        report,
+        config: c.config.clone(),
+        pdf_mismatch: mismatch,
+        pdf_outliers: outliers as f64 / N as f64,
+        pdf_match: c.pdf_match,
+        seconds: t0.elapsed().as_secs_f64(),
+    }
 }
 
 /// Runs cases, prints and records their rows, and asserts they all passed.
@@ -717,7 +764,9 @@ fn run_all(group: &str, cases: &[Case]) {
     let failed: Vec<String> = rows
         .iter()
         .filter(|r| !r.report.passed() || !(r.pdf_outliers <= r.pdf_match.1))
-        .map(|r| format!("{} (pdf mismatch max {:.2e}, outliers {:.1e})", r.report.summary(), r.pdf_mismatch, r.pdf_outliers))
+        .map(|r| {
+            format!("{} (pdf mismatch max {:.2e}, outliers {:.1e})", r.report.summary(), r.pdf_mismatch, r.pdf_outliers)
+        })
         .collect();
     assert!(failed.is_empty(), "{} of {} {group} tests failed:\n{}", failed.len(), rows.len(), failed.join("\n"));
 }
@@ -762,16 +811,36 @@ fn deg(x: f64) -> f64 {
 fn warp_cases() -> Vec<Case> {
     let z = DVec3::Z;
     let mut v = vec![
-        Case::new("uniform hemisphere", "sphere around n".into(), Setup::new(SceneId::Lights, R_UNIFORM_HEMISPHERE), Dom::Cap(SphereCap::sphere(z, GRID))),
-        Case::new("cosine hemisphere", "sphere around n".into(), Setup::new(SceneId::Lights, R_COSINE_HEMISPHERE), Dom::Cap(SphereCap::sphere(z, GRID))),
-        Case::new("uniform sphere", "sphere".into(), Setup::new(SceneId::Lights, R_UNIFORM_SPHERE), Dom::Cap(SphereCap::sphere(z, GRID))),
+        Case::new(
+            "uniform hemisphere",
+            "sphere around n".into(),
+            Setup::new(SceneId::Lights, R_UNIFORM_HEMISPHERE),
+            Dom::Cap(SphereCap::sphere(z, GRID)),
+        ),
+        Case::new(
+            "cosine hemisphere",
+            "sphere around n".into(),
+            Setup::new(SceneId::Lights, R_COSINE_HEMISPHERE),
+            Dom::Cap(SphereCap::sphere(z, GRID)),
+        ),
+        Case::new(
+            "uniform sphere",
+            "sphere".into(),
+            Setup::new(SceneId::Lights, R_UNIFORM_SPHERE),
+            Dom::Cap(SphereCap::sphere(z, GRID)),
+        ),
     ];
     for theta in [deg(30.0), deg(120.0)] {
         let omc = 1.0 - theta.cos();
         let mut s = Setup::new(SceneId::Lights, R_CONE);
         s.job.a[0] = omc as f32;
         let omc32 = s.job.a[0] as f64;
-        let mut c = Case::new("uniform cone", format!("θmax = {:.0}°", theta.to_degrees()), s, Dom::Cap(SphereCap::cap(z, (omc32 / 0.505).min(2.0), GRID)));
+        let mut c = Case::new(
+            "uniform cone",
+            format!("θmax = {:.0}°", theta.to_degrees()),
+            s,
+            Dom::Cap(SphereCap::cap(z, (omc32 / 0.505).min(2.0), GRID)),
+        );
         // The pdf function has no direction argument: the support (1 − cosθ ≤ 1 − cosθmax) comes from here.
         c.pdf_input = Box::new(move |w| {
             let o = if w.z > 0.0 { (w.x * w.x + w.y * w.y) / (1.0 + w.z) } else { 1.0 - w.z };
@@ -914,10 +983,18 @@ fn solid_angle(geom: &LightGeom, p: DVec3) -> f64 {
 }
 
 /// Shading points of the polygon cases, in the light's local frame (s, t, height).
-const TRI_POINTS: [(&str, [f64; 3]); 4] =
-    [("moderate", [0.4, 0.3, 1.5]), ("close", [0.45, 0.3, 0.1]), ("grazing", [2.5, 0.4, 0.08]), ("tiny", [0.4, 0.3, 300.0])];
-const RECT_POINTS: [(&str, [f64; 3]); 4] =
-    [("moderate", [0.5, 0.2, 1.3]), ("close", [0.6, 0.35, 0.15]), ("grazing", [3.0, 0.35, 0.05]), ("grazing-y", [0.6, -2.5, 0.02])];
+const TRI_POINTS: [(&str, [f64; 3]); 4] = [
+    ("moderate", [0.4, 0.3, 1.5]),
+    ("close", [0.45, 0.3, 0.1]),
+    ("grazing", [2.5, 0.4, 0.08]),
+    ("tiny", [0.4, 0.3, 300.0]),
+];
+const RECT_POINTS: [(&str, [f64; 3]); 4] = [
+    ("moderate", [0.5, 0.2, 1.3]),
+    ("close", [0.6, 0.35, 0.15]),
+    ("grazing", [3.0, 0.35, 0.05]),
+    ("grazing-y", [0.6, -2.5, 0.02]),
+];
 
 fn light_cases() -> Vec<Case> {
     let mut v = Vec::new();
@@ -1018,7 +1095,16 @@ fn one_sided_emitters() {
 // ---------------------------------------------------------------------------------------------------------------
 // BSDF
 
-fn bsdf_case(name: &str, config: String, wo: DVec3, base: [f32; 3], metallic: f32, alpha: f32, specular: f32, dom: Dom) -> Case {
+fn bsdf_case(
+    name: &str,
+    config: String,
+    wo: DVec3,
+    base: [f32; 3],
+    metallic: f32,
+    alpha: f32,
+    specular: f32,
+    dom: Dom,
+) -> Case {
     let mut s = Setup::new(SceneId::Lights, R_BSDF);
     s.job.p = v4(wo, 0.0);
     s.job.a = [alpha, specular, 0.0, 0.0];
@@ -1037,7 +1123,11 @@ fn ggx_half_vector_case(name: &str, config: String, wo: DVec3, alpha: f32, cap: 
     // support (wo·h = 0, wi.z = 0), which passes within ~α of the normal at grazing incidence, crosses rows.
     let side = DVec3::new(wo.x, wo.y, 0.0).normalize_or_zero();
     let axis = (DVec3::Z + 0.5 * (alpha as f64).min(0.6) * side).normalize();
-    let dom = if cap >= PI { Dom::Cap(SphereCap::sphere(axis, GRID)) } else { Dom::Cap(SphereCap::cap_angle(axis, cap, GRID)) };
+    let dom = if cap >= PI {
+        Dom::Cap(SphereCap::sphere(axis, GRID))
+    } else {
+        Dom::Cap(SphereCap::cap_angle(axis, cap, GRID))
+    };
     let mut c = bsdf_case(name, config, wo, [1.0; 3], 1.0, alpha, 1.0, dom);
     c.to_domain = Some(Box::new(move |wi, _| Some((wo + wi).normalize())));
     c.pdf_input = Box::new(move |h| {
@@ -1085,7 +1175,15 @@ fn chi2_bsdf() {
 // ---------------------------------------------------------------------------------------------------------------
 // Environment
 
-fn env_case(name: &str, config: &str, scene: SceneId, grid: (usize, usize), base: Quadrature, refine: Option<Quadrature>, importance: bool) -> Case {
+fn env_case(
+    name: &str,
+    config: &str,
+    scene: SceneId,
+    grid: (usize, usize),
+    base: Quadrature,
+    refine: Option<Quadrature>,
+    importance: bool,
+) -> Case {
     let mut s = Setup::new(scene, R_ENV);
     if !importance {
         s.frame.env_sampling = EnvSampling::Uniform.tag();
@@ -1101,10 +1199,42 @@ fn env_cases() -> Vec<Case> {
     // Texel edges fall inside cells (so an f32 sample on an edge never lands in a cell of pdf 0) but on sub-cell
     // boundaries of the quadrature; pdf·Jacobian is constant inside a texel, so one point per sub-cell is exact.
     vec![
-        env_case("environment importance", "single bright texel of 20×10, rotated 0.3", SceneId::EnvPixel, (104, 204), Quadrature { sub: 5, gauss: 1 }, None, true),
-        env_case("environment importance", "3×2 map (1:1000, one black texel)", SceneId::Env3x2, (101, 202), Quadrature { sub: 6, gauss: 1 }, None, true),
-        env_case("environment importance", "noon_grass_1k.hdr (1024×512)", SceneId::EnvHdr, (128, 256), Quadrature { sub: 4, gauss: 1 }, None, true),
-        env_case("environment uniform", "noon_grass_1k.hdr (1024×512)", SceneId::EnvHdr, GRID, Quadrature { sub: 1, gauss: 2 }, None, false),
+        env_case(
+            "environment importance",
+            "single bright texel of 20×10, rotated 0.3",
+            SceneId::EnvPixel,
+            (104, 204),
+            Quadrature { sub: 5, gauss: 1 },
+            None,
+            true,
+        ),
+        env_case(
+            "environment importance",
+            "3×2 map (1:1000, one black texel)",
+            SceneId::Env3x2,
+            (101, 202),
+            Quadrature { sub: 6, gauss: 1 },
+            None,
+            true,
+        ),
+        env_case(
+            "environment importance",
+            "noon_grass_1k.hdr (1024×512)",
+            SceneId::EnvHdr,
+            (128, 256),
+            Quadrature { sub: 4, gauss: 1 },
+            None,
+            true,
+        ),
+        env_case(
+            "environment uniform",
+            "noon_grass_1k.hdr (1024×512)",
+            SceneId::EnvHdr,
+            GRID,
+            Quadrature { sub: 1, gauss: 2 },
+            None,
+            false,
+        ),
     ]
 }
 
@@ -1133,10 +1263,20 @@ fn chi2_light_selection() {
         let pts: Vec<[[f32; 4]; 2]> = (0..n_lights).map(|i| [[i as f32, 0.0, 0.0, 0.0], [0.0; 4]]).collect();
         let pmf = h.pdf(&s, &pts);
         // The pmf the selection returned with each sample is light_pmf of that index.
-        let mismatch = out.iter().map(|[a, _]| ((a[1] as f64 - pmf[a[0] as usize]) / pmf[a[0] as usize]).abs()).fold(0.0, f64::max);
+        let mismatch = out
+            .iter()
+            .map(|[a, _]| ((a[1] as f64 - pmf[a[0] as usize]) / pmf[a[0] as usize]).abs())
+            .fold(0.0, f64::max);
         let report = chi2::discrete_test(&format!("light selection ({select})"), &counts, &pmf, alpha());
         eprintln!("{}  [pmf {:?}]", report.summary(), pmf.iter().map(|p| format!("{p:.4}")).collect::<Vec<_>>());
-        rows.push(Row { report, config: format!("{n_lights} lights"), pdf_mismatch: mismatch, pdf_outliers: 0.0, pdf_match: (0.0, 0.0), seconds: t0.elapsed().as_secs_f64() });
+        rows.push(Row {
+            report,
+            config: format!("{n_lights} lights"),
+            pdf_mismatch: mismatch,
+            pdf_outliers: 0.0,
+            pdf_match: (0.0, 0.0),
+            seconds: t0.elapsed().as_secs_f64(),
+        });
     }
     record("selection", &rows);
     for r in &rows {
@@ -1264,7 +1404,8 @@ fn reference_spherical_triangle(a: DVec3, b: DVec3, c: DVec3, u: [f64; 2]) -> DV
     let cos_phi = ap_pi.cos() * cos_alpha + ap_pi.sin() * sin_alpha;
     let k1 = cos_phi + cos_alpha;
     let k2 = sin_phi - sin_alpha * a.dot(b);
-    let cos_bp = ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha)).clamp(-1.0, 1.0);
+    let cos_bp = ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha))
+        .clamp(-1.0, 1.0);
     let sin_bp = (1.0 - cos_bp * cos_bp).max(0.0).sqrt();
     let cp = cos_bp * a + sin_bp * gram_schmidt(c, a).normalize();
     let cos_theta = 1.0 - u[1] * (1.0 - cp.dot(b));
@@ -1313,7 +1454,10 @@ fn barycentrics(a: DVec3, b: DVec3, c: DVec3, w: DVec3) -> [f64; 2] {
 /// A WGSL `const NAME: f32 = value;` of lights.wgsl.
 fn wgsl_const(name: &str) -> f64 {
     let src = mislab::shaders::file("lights.wgsl");
-    let line = src.lines().find(|l| l.trim_start().starts_with(&format!("const {name}:"))).unwrap_or_else(|| panic!("{name} not in lights.wgsl"));
+    let line = src
+        .lines()
+        .find(|l| l.trim_start().starts_with(&format!("const {name}:")))
+        .unwrap_or_else(|| panic!("{name} not in lights.wgsl"));
     line.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap()
 }
 
@@ -1344,14 +1488,21 @@ fn mine_spherical_rect(x0: f64, y0: f64, w: f64, hgt: f64, h: f64, u: [f64; 2]) 
     let sigma = b0.atan2(h) + b1.atan2(h);
     let delta = (h * lb).atan2(h * h + b0 * b1);
     let psi = psi0 + u[0] * (psi1 - psi0);
-    let q = (0.5 * (sigma + psi)).cos() * (0.5 * (sigma - psi)).cos() * (0.5 * (delta - psi)).sin() * (0.5 * (delta + psi)).sin();
+    let q = (0.5 * (sigma + psi)).cos()
+        * (0.5 * (sigma - psi)).cos()
+        * (0.5 * (delta - psi)).sin()
+        * (0.5 * (delta + psi)).sin();
     let a = (h * psi.sin() / (2.0 * q.max(0.0).sqrt())).clamp(a0, a1);
     let dd2 = a * a + h * h;
     let hh0 = b0 / (dd2 + b0 * b0).sqrt();
     let hh1 = b1 / (dd2 + b1 * b1).sqrt();
     let hv = hh0 + u[1] * (hh1 - hh0);
     let b = (hv * dd2.sqrt() / (1.0 - hv * hv).sqrt()).clamp(b0, b1);
-    if swap { [b, a] } else { [a, b] }
+    if swap {
+        [b, a]
+    } else {
+        [a, b]
+    }
 }
 
 /// Lattice of u used for the precision measurement: 65 × 65 including 0 and 1⁻ (as the kernel computes it).
@@ -1367,7 +1518,9 @@ fn lattice_u(i: usize) -> [f64; 2] {
 #[test]
 fn spherical_warp_formulas_match_pbrt() {
     let tri = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.3, 0.8, 0.0)];
-    for p in [DVec3::new(0.7, 0.1, 0.9), DVec3::new(0.4, 0.3, 0.1), DVec3::new(-2.0, 1.0, 0.5), DVec3::new(0.4, 0.3, 30.0)] {
+    for p in
+        [DVec3::new(0.7, 0.1, 0.9), DVec3::new(0.4, 0.3, 0.1), DVec3::new(-2.0, 1.0, 0.5), DVec3::new(0.4, 0.3, 30.0)]
+    {
         let rel = tri.map(|v| v - p);
         let worst = (0..(LATTICE * LATTICE) as usize)
             .map(|i| {
@@ -1417,7 +1570,10 @@ fn spherical_warps_precision() {
 
     // Triangles: a regular one and a sliver; far along a tilted direction, close above the interior (centroid,
     // near an edge, near a vertex), and grazing (in the plane, beside the triangle).
-    let shapes = [("", [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.3, 0.8, 0.0)]), ("sliver ", [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.45, 0.01, 0.0)])];
+    let shapes = [
+        ("", [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.3, 0.8, 0.0)]),
+        ("sliver ", [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.45, 0.01, 0.0)]),
+    ];
     for (shape, tri2d) in shapes {
         let centroid = (tri2d[0] + tri2d[1] + tri2d[2]) / 3.0;
         let mut pts: Vec<(String, DVec3)> = Vec::new();
@@ -1425,7 +1581,11 @@ fn spherical_warps_precision() {
             let d = 0.5 * 10f64.powf(k as f64 / 4.0);
             pts.push((format!("{shape}far d = {d:.2e}"), centroid + DVec3::new(0.3, -0.2, 1.0).normalize() * d));
         }
-        let interior = [("centroid", centroid), ("near edge", 0.5 * (tri2d[0] + tri2d[1]) + DVec3::new(0.0, 0.002, 0.0)), ("near vertex", tri2d[0] * 0.98 + centroid * 0.02)];
+        let interior = [
+            ("centroid", centroid),
+            ("near edge", 0.5 * (tri2d[0] + tri2d[1]) + DVec3::new(0.0, 0.002, 0.0)),
+            ("near vertex", tri2d[0] * 0.98 + centroid * 0.02),
+        ];
         for (what, q) in interior {
             for hh in [1e-1, 3e-2, 1e-2, 5e-3, 3e-3, 2e-3, 1e-3, 5e-4, 3e-4, 2e-4, 1e-4, 1e-6] {
                 pts.push((format!("{shape}close ({what}) h = {hh:.0e}"), q + DVec3::new(0.0, 0.0, hh)));
@@ -1447,15 +1607,21 @@ fn spherical_warps_precision() {
             let omega_err = ((1.0 / out[0][0][3] as f64) / omega - 1.0).abs();
             let mut pos_err: f64 = 0.0;
             for (i, [a, _]) in out.iter().enumerate() {
-                let want = barycentrics(rel[0], rel[1], rel[2], mine_spherical_triangle(rel[0], rel[1], rel[2], lattice_u(i)));
+                let want =
+                    barycentrics(rel[0], rel[1], rel[2], mine_spherical_triangle(rel[0], rel[1], rel[2], lattice_u(i)));
                 let got = barycentrics(rel[0], rel[1], rel[2], d3(a));
                 let e = (got[0] - want[0]).abs().max((got[1] - want[1]).abs());
                 pos_err = pos_err.max(if e.is_finite() { e } else { f64::INFINITY });
             }
             let used = omega >= tri_min && omega <= tri_max;
-            table += &format!("| spherical triangle | {name} | {omega:.3e} | {pos_err:.1e} | {omega_err:.1e} | {} |\n", if used { "solid angle" } else { "area" });
+            table += &format!(
+                "| spherical triangle | {name} | {omega:.3e} | {pos_err:.1e} | {omega_err:.1e} | {} |\n",
+                if used { "solid angle" } else { "area" }
+            );
             if used && !(pos_err <= TOL && omega_err <= TOL) {
-                failures.push(format!("triangle {name}: Ω = {omega:.3e}, position error {pos_err:.1e}, Ω error {omega_err:.1e}"));
+                failures.push(format!(
+                    "triangle {name}: Ω = {omega:.3e}, position error {pos_err:.1e}, Ω error {omega_err:.1e}"
+                ));
             }
         }
     }
@@ -1468,7 +1634,11 @@ fn spherical_warps_precision() {
             let dir = DVec3::new(0.3, -0.2, 1.0).normalize() * d;
             pts.push((format!("{shape}far d = {d:.2e}"), [-0.5 * w - dir.x, -0.5 * hgt - dir.y, dir.z]));
         }
-        for (what, x0, y0) in [("centre", -0.5 * w, -0.5 * hgt), ("near edge", -0.5 * w, -0.002 * hgt), ("near corner", -0.01 * w, -0.01 * hgt)] {
+        for (what, x0, y0) in [
+            ("centre", -0.5 * w, -0.5 * hgt),
+            ("near edge", -0.5 * w, -0.002 * hgt),
+            ("near corner", -0.01 * w, -0.01 * hgt),
+        ] {
             for hh in [1e-1, 3e-2, 1e-2, 5e-3, 3e-3, 2e-3, 1e-3, 5e-4, 3e-4, 2e-4, 1e-4, 1e-6] {
                 pts.push((format!("{shape}close ({what}) h = {hh:.0e}"), [x0, y0, hh]));
             }
@@ -1485,7 +1655,10 @@ fn spherical_warps_precision() {
             s.job.a = [r[4] as f32, 0.0, 0.0, 0.0];
             let out = h.sample(&s, LATTICE * LATTICE, FLAG_LATTICE, LATTICE, 0);
             let corner = DVec3::new(r[0], r[1], -r[4]);
-            let omega = solid_angle(&LightGeom::Quad([corner, DVec3::new(r[2], 0.0, 0.0), DVec3::new(0.0, r[3], 0.0)]), DVec3::ZERO);
+            let omega = solid_angle(
+                &LightGeom::Quad([corner, DVec3::new(r[2], 0.0, 0.0), DVec3::new(0.0, r[3], 0.0)]),
+                DVec3::ZERO,
+            );
             let omega_err = ((1.0 / out[0][0][3] as f64) / omega - 1.0).abs();
             let mut pos_err: f64 = 0.0;
             for (i, [a, _]) in out.iter().enumerate() {
@@ -1494,9 +1667,14 @@ fn spherical_warps_precision() {
                 pos_err = pos_err.max(if e.is_finite() { e } else { f64::INFINITY });
             }
             let used = omega >= rect_min && omega <= rect_max;
-            table += &format!("| spherical rectangle | {name} | {omega:.3e} | {pos_err:.1e} | {omega_err:.1e} | {} |\n", if used { "solid angle" } else { "area" });
+            table += &format!(
+                "| spherical rectangle | {name} | {omega:.3e} | {pos_err:.1e} | {omega_err:.1e} | {} |\n",
+                if used { "solid angle" } else { "area" }
+            );
             if used && !(pos_err <= TOL && omega_err <= TOL) {
-                failures.push(format!("rectangle {name}: Ω = {omega:.3e}, position error {pos_err:.1e}, Ω error {omega_err:.1e}"));
+                failures.push(format!(
+                    "rectangle {name}: Ω = {omega:.3e}, position error {pos_err:.1e}, Ω error {omega_err:.1e}"
+                ));
             }
         }
     }

@@ -15,7 +15,10 @@ fn every_file_is_embedded_and_nonempty() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let name = entry.unwrap().file_name().into_string().unwrap();
         if name.ends_with(".wgsl") {
-            assert!(mislab::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty()), "{name} is not embedded in src/shaders.rs");
+            assert!(
+                mislab::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty()),
+                "{name} is not embedded in src/shaders.rs"
+            );
         }
     }
 }

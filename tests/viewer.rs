@@ -22,8 +22,19 @@ const WAIT: Duration = Duration::from_secs(240);
 
 /// Every setting the CLI has, by its flag name.
 const SETTING_NAMES: &[&str] = &[
-    "mode", "strategy", "light-sampling", "env-sampling", "light-select", "heuristic", "power-beta", "mis", "light-samples",
-    "bsdf-samples", "sampler", "max-depth", "seed",
+    "mode",
+    "strategy",
+    "light-sampling",
+    "env-sampling",
+    "light-select",
+    "heuristic",
+    "power-beta",
+    "mis",
+    "light-samples",
+    "bsdf-samples",
+    "sampler",
+    "max-depth",
+    "seed",
 ];
 
 /// A small film keeps every test fast on lavapipe. Without the generic pipeline: its first compile
@@ -66,7 +77,9 @@ fn select(h: &mut Harness<'static, Viewer>, setting: &str, side: usize, option: 
     h.step();
     h.step();
     // The option in the open popup (not a closed combo box that happens to share the name, like "mis").
-    let by = egui_kittest::kittest::By::new().label(option).predicate(|n| !matches!(n.role(), eframe::egui::accesskit::Role::ComboBox | eframe::egui::accesskit::Role::Label));
+    let by = egui_kittest::kittest::By::new().label(option).predicate(|n| {
+        !matches!(n.role(), eframe::egui::accesskit::Role::ComboBox | eframe::egui::accesskit::Role::Label)
+    });
     h.get_all(by).last().unwrap_or_else(|| panic!("'{setting}' offers no '{option}'")).click();
     h.step();
     h.step();
@@ -120,11 +133,18 @@ fn toggling_the_strategy_changes_the_renderer_and_restarts_its_samples() {
     {
         let s = h.state().engine().shared();
         assert_eq!(s.stats[0].settings.strategy, Strategy::Light, "the renderer's settings changed");
-        assert!(s.stats[0].spp < spp_before, "the sample count restarted ({} spp before, {} after)", spp_before, s.stats[0].spp);
+        assert!(
+            s.stats[0].spp < spp_before,
+            "the sample count restarted ({} spp before, {} after)",
+            spp_before,
+            s.stats[0].spp
+        );
         assert_eq!(s.stats[0].generation, generation + 1, "exactly one restart");
     }
     // The first image of the new estimator reaches the UI.
-    step_until(&mut h, "a frame of the new estimator", |s| s.frame.as_ref().is_some_and(|f| f.generations[0] > generation && f.shown[0]));
+    step_until(&mut h, "a frame of the new estimator", |s| {
+        s.frame.as_ref().is_some_and(|f| f.generations[0] > generation && f.shown[0])
+    });
     h.step();
     assert_eq!(h.state().toggle_latencies_ms.len(), 1, "the toggle was timed to its first image");
 }
@@ -143,7 +163,11 @@ fn exposure_and_view_do_not_restart_but_compare_renders_both_sides() {
     for _ in 0..10 {
         h.step();
     }
-    assert_eq!(h.state().engine().shared().stats[0].generation, generation, "display options never restart the accumulation");
+    assert_eq!(
+        h.state().engine().shared().stats[0].generation,
+        generation,
+        "display options never restart the accumulation"
+    );
 
     h.get_by_label("compare A | B").click();
     h.step();
@@ -153,7 +177,9 @@ fn exposure_and_view_do_not_restart_but_compare_renders_both_sides() {
     select(&mut h, "strategy", 1, "cosine");
     assert_eq!(h.state().settings[1].strategy, Strategy::Cosine);
     assert_eq!(h.state().settings[0].strategy, Strategy::Mis, "side A keeps its settings");
-    step_until(&mut h, "side B to render with cosine", |s| s.compare && s.stats[1].settings.strategy == Strategy::Cosine && s.stats[1].spp >= 1);
+    step_until(&mut h, "side B to render with cosine", |s| {
+        s.compare && s.stats[1].settings.strategy == Strategy::Cosine && s.stats[1].spp >= 1
+    });
     let s = h.state().engine().shared();
     assert!(s.stats[0].spp >= 1 && s.stats[1].samples_per_s > 0.0, "both sides have statistics");
     assert_eq!(s.stats[0].generation, generation, "side A was not restarted by side B's change");
@@ -165,7 +191,10 @@ fn camera_reset_and_device_loss_recover() {
     step_until(&mut h, "the first frame", |s| s.frames >= 1);
     // Zoom with the wheel over the image moves the camera; reset brings back the scene's camera.
     let home = h.state().engine().shared().home_camera.clone();
-    h.state().engine().send(Command::Camera(mislab::scene::Camera { position: home.position + glam::Vec3::new(0.5, 0.0, 0.0), ..home.clone() }));
+    h.state().engine().send(Command::Camera(mislab::scene::Camera {
+        position: home.position + glam::Vec3::new(0.5, 0.0, 0.0),
+        ..home.clone()
+    }));
     step_until(&mut h, "the moved camera", |s| s.camera.position != home.position);
     h.get_by_label("reset camera").click();
     h.step();
@@ -175,7 +204,10 @@ fn camera_reset_and_device_loss_recover() {
     h.state().engine().send(Command::LoseDevice);
     step_until(&mut h, "the device to be recreated", |s| s.recoveries >= 1);
     step_until(&mut h, "frames after the recovery", |s| s.frames > frames && s.stats[0].spp >= 1);
-    assert!(h.state().engine().shared().message.as_deref().unwrap_or("").contains("recreated"), "the status line says what happened");
+    assert!(
+        h.state().engine().shared().message.as_deref().unwrap_or("").contains("recreated"),
+        "the status line says what happened"
+    );
 }
 
 #[test]
@@ -228,7 +260,10 @@ fn snapshot_of_the_estimator_panel() {
         settings,
     );
     h.run();
-    h.snapshot_options("viewer_estimator_panel", &egui_kittest::SnapshotOptions::new().threshold(0.6).max_failed_pixels(40));
+    h.snapshot_options(
+        "viewer_estimator_panel",
+        &egui_kittest::SnapshotOptions::new().threshold(0.6).max_failed_pixels(40),
+    );
 }
 
 /// The display pass against its CPU twins: tonemapping as `film::tonemap`, the false-colour scale as
@@ -243,7 +278,12 @@ fn display_pass_matches_its_cpu_twin() {
     let mut accum = vec![GpuAccum::default(); n];
     for (i, a) in accum.iter_mut().enumerate() {
         let v = i as f32 / n as f32 * 1.5;
-        *a = GpuAccum { mean: [v, 0.5 * v, 0.25], count: 4 + (i as u32 % 3), m2: [0.01 * (i as f32 + 1.0); 3], nonfinite: 0 };
+        *a = GpuAccum {
+            mean: [v, 0.5 * v, 0.25],
+            count: 4 + (i as u32 % 3),
+            m2: [0.01 * (i as f32 + 1.0); 3],
+            nonfinite: 0,
+        };
     }
     accum[5] = GpuAccum::default(); // no samples yet: shows the preview
     accum[7].nonfinite = 2;
@@ -269,14 +309,25 @@ fn display_pass_matches_its_cpu_twin() {
             ..Default::default()
         };
         let mut enc = ctx.device.create_command_encoder(&Default::default());
-        pass.encode(&mut enc, &params, &DisplayInputs { accum: [&a, &a], preview: [&p, &p], reference: None }, true, None);
+        pass.encode(
+            &mut enc,
+            &params,
+            &DisplayInputs { accum: [&a, &a], preview: [&p, &p], reference: None },
+            true,
+            None,
+        );
         ctx.queue.submit([enc.finish()]);
         pass.read(&ctx, true).unwrap()
     };
     let px = |rgba: &[u8], i: usize| [rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]];
     let close = |got: [u8; 3], want: [f32; 3], what: &str| {
         for c in 0..3 {
-            assert!((got[c] as f32 - want[c] * 255.0).abs() <= 1.5, "{what}: channel {c} is {} , want {}", got[c], want[c] * 255.0);
+            assert!(
+                (got[c] as f32 - want[c] * 255.0).abs() <= 1.5,
+                "{what}: channel {c} is {} , want {}",
+                got[c],
+                want[c] * 255.0
+            );
         }
     };
     for (tm, exposure) in [(Tonemap::Clamp, 0.0), (Tonemap::Aces, 1.0)] {
@@ -344,12 +395,40 @@ fn display_layouts_match() {
         }};
     }
     check!("Accum", GpuAccum, [mean, count, m2, nonfinite]);
-    check!("DisplayParams", DisplayParams, [width, height, view, tonemap, exposure_scale, split_x, compare, has_reference,
-        preview_scale, preview_width, preview_height, log_min, log_max, row_offset, row_count, _pad0]);
+    check!(
+        "DisplayParams",
+        DisplayParams,
+        [
+            width,
+            height,
+            view,
+            tonemap,
+            exposure_scale,
+            split_x,
+            compare,
+            has_reference,
+            preview_scale,
+            preview_width,
+            preview_height,
+            log_min,
+            log_max,
+            row_offset,
+            row_count,
+            _pad0
+        ]
+    );
     check!("SideSums", display::SideSums, [rel_se, rel_se_n, sq_err, rel_mse, err_n, nonfinite_px, sampled_px, _pad0]);
     check!("Partial", display::Partial, [a, b]);
     for v in View::ALL {
-        let name = format!("VIEW_{}", match v { View::Image => "IMAGE", View::StdErr => "STDERR", View::RelMse => "RELMSE", View::NonFinite => "NONFINITE" });
+        let name = format!(
+            "VIEW_{}",
+            match v {
+                View::Image => "IMAGE",
+                View::StdErr => "STDERR",
+                View::RelMse => "RELMSE",
+                View::NonFinite => "NONFINITE",
+            }
+        );
         let c = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(&name)).unwrap_or_else(|| panic!("{name}"));
         match m.global_expressions[c.1.init] {
             naga::Expression::Literal(naga::Literal::U32(x)) => assert_eq!(x, v.tag(), "{name}"),
@@ -374,7 +453,10 @@ fn camera_controls() {
     assert!(o.camera.forward.dot(glam::Vec3::Y).abs() < 0.9999, "pitch stops short of the pole");
     let before = o.clone();
     o.pan(10.0, 0.0, 100.0);
-    assert!((o.camera.position - before.camera.position).dot(before.camera.forward).abs() < 1e-4, "pan stays in the image plane");
+    assert!(
+        (o.camera.position - before.camera.position).dot(before.camera.forward).abs() < 1e-4,
+        "pan stays in the image plane"
+    );
     let d = o.distance;
     o.zoom(0.5);
     assert!((o.distance - 0.5 * d).abs() < 1e-4);

@@ -24,8 +24,29 @@ fn screenshot_of_a_real_window_with_toggles() {
     }
     // `timeout` bounds the whole run: a hang is a failure, never a stuck CI job.
     let out = Command::new("timeout")
-        .args(["900", "xvfb-run", "-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_mislab"), "view", "veach-mis"])
-        .args(["--width", "256", "--height", "256", "--compare", "bsdf", "--toggles", "2", "--frames", "10", "--screenshot"])
+        .args([
+            "900",
+            "xvfb-run",
+            "-a",
+            "-s",
+            "-screen 0 1280x800x24",
+            env!("CARGO_BIN_EXE_mislab"),
+            "view",
+            "veach-mis",
+        ])
+        .args([
+            "--width",
+            "256",
+            "--height",
+            "256",
+            "--compare",
+            "bsdf",
+            "--toggles",
+            "2",
+            "--frames",
+            "10",
+            "--screenshot",
+        ])
         .arg(&shot)
         .env("XDG_RUNTIME_DIR", &runtime)
         .output()
@@ -36,10 +57,20 @@ fn screenshot_of_a_real_window_with_toggles() {
     assert!(stderr.contains("first image of the new estimator"), "it reports the toggle latency:\n{stderr}");
     let img = image::open(&shot).expect("the screenshot was written").to_rgb8();
     let panel = mislab::viewer::app::PANEL_WIDTH as u32;
-    assert!(img.width() >= panel + 256 && img.height() >= 256, "the window holds the panel and the image: {}x{}", img.width(), img.height());
+    assert!(
+        img.width() >= panel + 256 && img.height() >= 256,
+        "the window holds the panel and the image: {}x{}",
+        img.width(),
+        img.height()
+    );
     // The panel has text (bright pixels on the dark theme) and the image area has a rendered,
     // non-uniform picture.
-    let bright = |x0: u32, x1: u32| (x0..x1).flat_map(|x| (0..img.height()).map(move |y| (x, y))).filter(|&(x, y)| img.get_pixel(x, y).0.iter().any(|&c| c > 150)).count();
+    let bright = |x0: u32, x1: u32| {
+        (x0..x1)
+            .flat_map(|x| (0..img.height()).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0.iter().any(|&c| c > 150))
+            .count()
+    };
     assert!(bright(0, panel) > 500, "the panel shows text");
     assert!(bright(panel + 10, img.width()) > 200, "the image area shows a rendered image");
     let _ = std::fs::remove_dir_all(&dir);

@@ -649,7 +649,11 @@ impl<'a> Loader<'a> {
         let bad: Vec<(u32, Vec3)> = used.filter(|(_, p)| !p.is_finite()).collect();
         if let Some(&(i, p)) = bad.first() {
             let file_value = geometry.positions[i as usize];
-            let (source, p) = if file_value.is_finite() { ("its node transform makes it non-finite", p) } else { ("POSITION holds NaN/Inf", file_value) };
+            let (source, p) = if file_value.is_finite() {
+                ("its node transform makes it non-finite", p)
+            } else {
+                ("POSITION holds NaN/Inf", file_value)
+            };
             return Err(format!(
                 "{what}: non-finite vertex position: vertex {i} is ({}, {}, {}) ({source}; {} use(s) by triangles in all)",
                 p.x,

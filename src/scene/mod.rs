@@ -172,7 +172,13 @@ impl Material {
     }
     /// A GGX conductor with Fresnel = 1 (reflectance tints it) and the given α.
     pub fn conductor(name: &str, reflectance: Vec3, alpha: f32) -> Self {
-        Material { name: name.into(), base_color: reflectance, metallic: 1.0, roughness: alpha.max(0.0).sqrt(), ..Default::default() }
+        Material {
+            name: name.into(),
+            base_color: reflectance,
+            metallic: 1.0,
+            roughness: alpha.max(0.0).sqrt(),
+            ..Default::default()
+        }
     }
     /// A black emitter of the given radiance.
     pub fn emitter(name: &str, radiance: Vec3) -> Self {
@@ -289,7 +295,9 @@ impl Scene {
     }
     /// Whether anything emits light (area emitters, punctual lights, environment).
     pub fn has_lights(&self) -> bool {
-        let emissive = |m: u32| self.materials.get(m as usize).is_some_and(|mat| mat.is_emissive() || mat.emissive_texture.is_some());
+        let emissive = |m: u32| {
+            self.materials.get(m as usize).is_some_and(|mat| mat.is_emissive() || mat.emissive_texture.is_some())
+        };
         self.meshes.iter().any(|m| emissive(m.material))
             || self.spheres.iter().any(|s| emissive(s.material))
             || self.quads.iter().any(|q| emissive(q.material))

@@ -2,12 +2,12 @@
 //! name), display options with the false-colour legend, the A | B comparison with its divider, the
 //! statistics, camera control, opening and saving files. Runs the same under eframe and egui_kittest.
 
-use eframe::egui;
 use super::camera::Orbit;
 use super::display::{self, View, TONEMAPS};
 use super::engine::{Command, DisplayOptions, EngineHandle, Frame, Side, SideStats};
 use crate::film::Tonemap;
 use crate::settings::*;
+use eframe::egui;
 use egui::{Color32, Pos2, Rect, Sense, Vec2};
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -58,7 +58,13 @@ pub struct Viewer {
 
 impl Viewer {
     /// A viewer driving `engine`, whose starting state is `settings` / `compare` / `display`.
-    pub fn new(engine: EngineHandle, settings: [Settings; 2], compare: bool, display: DisplayOptions, scene_path: String) -> Viewer {
+    pub fn new(
+        engine: EngineHandle,
+        settings: [Settings; 2],
+        compare: bool,
+        display: DisplayOptions,
+        scene_path: String,
+    ) -> Viewer {
         Viewer {
             engine,
             settings,
@@ -95,7 +101,9 @@ impl Viewer {
     /// UI frames per second over the last two seconds.
     pub fn ui_fps(&self) -> f64 {
         match (self.ui_frames.front(), self.ui_frames.back()) {
-            (Some(a), Some(b)) if self.ui_frames.len() > 1 => (self.ui_frames.len() - 1) as f64 / (*b - *a).as_secs_f64().max(1e-9),
+            (Some(a), Some(b)) if self.ui_frames.len() > 1 => {
+                (self.ui_frames.len() - 1) as f64 / (*b - *a).as_secs_f64().max(1e-9)
+            }
             _ => 0.0,
         }
     }
@@ -122,7 +130,8 @@ impl Viewer {
         if self.frame.as_ref().is_some_and(|f| f.serial == frame.serial) {
             return;
         }
-        let image = egui::ColorImage::from_rgba_premultiplied([frame.width as usize, frame.height as usize], &frame.rgba);
+        let image =
+            egui::ColorImage::from_rgba_premultiplied([frame.width as usize, frame.height as usize], &frame.rgba);
         match &mut self.texture {
             Some(t) => t.set(image, egui::TextureOptions::NEAREST),
             None => self.texture = Some(ctx.load_texture("mislab-film", image, egui::TextureOptions::NEAREST)),
@@ -184,7 +193,9 @@ impl Viewer {
     }
 
     fn dropped_files(&mut self, ctx: &egui::Context) {
-        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect());
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
+        });
         for p in dropped {
             self.open_path(p);
         }
@@ -207,7 +218,10 @@ impl Viewer {
             }
             "exr" => {
                 let film = (self.settings[0].width, self.settings[0].height);
-                let dims = image::ImageReader::open(&p).ok().and_then(|r| r.with_guessed_format().ok()).and_then(|r| r.into_dimensions().ok());
+                let dims = image::ImageReader::open(&p)
+                    .ok()
+                    .and_then(|r| r.with_guessed_format().ok())
+                    .and_then(|r| r.into_dimensions().ok());
                 if dims == Some(film) {
                     self.reference_path = s;
                     self.engine.send(Command::LoadReference(p));
@@ -216,7 +230,10 @@ impl Viewer {
                     self.engine.send(Command::OpenEnv(p));
                 }
             }
-            _ => self.status = format!("{s}: not a scene (.gltf/.glb/.toml), environment (.hdr/.exr) or reference (.exr)"),
+            _ => {
+                self.status =
+                    format!("{s}: not a scene (.gltf/.glb/.toml), environment (.hdr/.exr) or reference (.exr)")
+            }
         }
     }
 
@@ -228,7 +245,11 @@ impl Viewer {
         };
         ui.label(format!("scene: {scene}"));
         ui.small(format!("device: {device}"));
-        ui.small(format!("UI {:.0} frames/s · {fps_line}{}", self.ui_fps(), if compiling > 0 { format!(" · compiling {compiling} pipeline(s)") } else { String::new() }));
+        ui.small(format!(
+            "UI {:.0} frames/s · {fps_line}{}",
+            self.ui_fps(),
+            if compiling > 0 { format!(" · compiling {compiling} pipeline(s)") } else { String::new() }
+        ));
         if let Some(ms) = self.toggle_latencies_ms.last() {
             ui.small(format!("last toggle to first image: {ms:.0} ms"));
         }
@@ -252,12 +273,28 @@ impl Viewer {
 
         ui.strong("Display");
         let mut dirty = false;
-        labelled(ui, "exposure", |ui| ui.add(egui::Slider::new(&mut self.display.exposure, -10.0..=10.0).step_by(0.1).suffix(" stops")), &mut dirty);
-        dirty |= choice(ui, "tonemap".into(), "tonemap", &mut self.display.tonemap, TONEMAPS, |t| display::tonemap_name(*t));
+        labelled(
+            ui,
+            "exposure",
+            |ui| ui.add(egui::Slider::new(&mut self.display.exposure, -10.0..=10.0).step_by(0.1).suffix(" stops")),
+            &mut dirty,
+        );
+        dirty |=
+            choice(ui, "tonemap".into(), "tonemap", &mut self.display.tonemap, TONEMAPS, |t| display::tonemap_name(*t));
         dirty |= choice(ui, "view".into(), "view", &mut self.display.view, View::ALL, |v| v.name());
         if self.display.view.false_colour() {
-            labelled(ui, "scale min (log10)", |ui| ui.add(egui::DragValue::new(&mut self.display.log_range[0]).range(-12.0..=12.0).speed(0.05)), &mut dirty);
-            labelled(ui, "scale max (log10)", |ui| ui.add(egui::DragValue::new(&mut self.display.log_range[1]).range(-12.0..=12.0).speed(0.05)), &mut dirty);
+            labelled(
+                ui,
+                "scale min (log10)",
+                |ui| ui.add(egui::DragValue::new(&mut self.display.log_range[0]).range(-12.0..=12.0).speed(0.05)),
+                &mut dirty,
+            );
+            labelled(
+                ui,
+                "scale max (log10)",
+                |ui| ui.add(egui::DragValue::new(&mut self.display.log_range[1]).range(-12.0..=12.0).speed(0.05)),
+                &mut dirty,
+            );
             if self.display.log_range[1] <= self.display.log_range[0] + 0.1 {
                 self.display.log_range[1] = self.display.log_range[0] + 0.1;
             }
@@ -328,7 +365,8 @@ impl Viewer {
         match ext.as_str() {
             "png" => match &self.frame {
                 Some(f) => {
-                    let img = image::RgbaImage::from_raw(f.width, f.height, f.rgba.clone()).expect("frame size matches its pixels");
+                    let img = image::RgbaImage::from_raw(f.width, f.height, f.rgba.clone())
+                        .expect("frame size matches its pixels");
                     self.status = match img.save(&path) {
                         Ok(()) => format!("wrote {}", path.display()),
                         Err(e) => format!("{}: {e}", path.display()),
@@ -357,7 +395,13 @@ impl Viewer {
             }
             None => {
                 painter.rect_filled(rect, 0.0, Color32::from_gray(20));
-                painter.text(rect.center(), egui::Align2::CENTER_CENTER, "compiling the render pipeline...", egui::FontId::proportional(16.0), Color32::GRAY);
+                painter.text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    "compiling the render pipeline...",
+                    egui::FontId::proportional(16.0),
+                    Color32::GRAY,
+                );
             }
         }
         let stats = self.engine.shared().stats.clone();
@@ -372,10 +416,18 @@ impl Viewer {
         let side_text = |s: &SideStats, name: &str| format!("{name}{} · {} spp", s.settings.strategy, s.spp);
         if self.compare {
             let x = rect.left() + self.display.split.clamp(0.0, 1.0) * rect.width();
-            painter.line_segment([Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())], egui::Stroke::new(2.0, Color32::WHITE));
+            painter.line_segment(
+                [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
+                egui::Stroke::new(2.0, Color32::WHITE),
+            );
             painter.circle_filled(Pos2::new(x, rect.center().y), 6.0, Color32::WHITE);
             label(&painter, rect.left_top() + Vec2::splat(6.0), egui::Align2::LEFT_TOP, side_text(&stats[0], "A: "));
-            label(&painter, rect.right_top() + Vec2::new(-6.0, 6.0), egui::Align2::RIGHT_TOP, side_text(&stats[1], "B: "));
+            label(
+                &painter,
+                rect.right_top() + Vec2::new(-6.0, 6.0),
+                egui::Align2::RIGHT_TOP,
+                side_text(&stats[1], "B: "),
+            );
             let near_divider = |p: Option<Pos2>| p.is_some_and(|p| (p.x - x).abs() < 10.0);
             if response.drag_started() && near_divider(response.interact_pointer_pos()) {
                 self.dragging_divider = true;
@@ -408,7 +460,9 @@ impl Viewer {
                 orbit.orbit(d.x * 0.01, d.y * 0.01);
                 moved = true;
             }
-        } else if response.dragged_by(egui::PointerButton::Secondary) || response.dragged_by(egui::PointerButton::Middle) {
+        } else if response.dragged_by(egui::PointerButton::Secondary)
+            || response.dragged_by(egui::PointerButton::Middle)
+        {
             let d = response.drag_delta();
             if d != Vec2::ZERO {
                 orbit.pan(d.x, d.y, rect.height());
@@ -435,7 +489,14 @@ fn plain(s: &str) -> String {
     s.chars()
         .map(|c| match c {
             '\u{2500}'..='\u{257F}' => '-',
-            c if (c as u32) < 0x2000 || matches!(c, '\u{2013}' | '\u{2014}' | '\u{2026}' | '\u{2018}' | '\u{2019}' | '\u{201C}' | '\u{201D}') => c,
+            c if (c as u32) < 0x2000
+                || matches!(
+                    c,
+                    '\u{2013}' | '\u{2014}' | '\u{2026}' | '\u{2018}' | '\u{2019}' | '\u{201C}' | '\u{201D}'
+                ) =>
+            {
+                c
+            }
             _ => '?',
         })
         .collect()
@@ -451,7 +512,14 @@ fn labelled(ui: &mut egui::Ui, name: &str, add: impl FnOnce(&mut egui::Ui) -> eg
 }
 
 /// A combo box named `label` choosing among `all`; returns whether the value changed.
-fn choice<T: Copy + PartialEq>(ui: &mut egui::Ui, id: String, label: &str, v: &mut T, all: &[T], name: impl Fn(&T) -> &'static str) -> bool {
+fn choice<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    id: String,
+    label: &str,
+    v: &mut T,
+    all: &[T],
+    name: impl Fn(&T) -> &'static str,
+) -> bool {
     let mut changed = false;
     egui::ComboBox::new(id, label).selected_text(name(v)).width(130.0).show_ui(ui, |ui| {
         for x in all {
@@ -464,7 +532,14 @@ fn choice<T: Copy + PartialEq>(ui: &mut egui::Ui, id: String, label: &str, v: &m
 }
 
 /// A combo box without a label of its own, named by `label` (the row's label in a grid).
-fn grid_choice<T: Copy + PartialEq>(ui: &mut egui::Ui, id: String, label: egui::Id, v: &mut T, all: &[T], name: impl Fn(&T) -> &'static str) -> bool {
+fn grid_choice<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    id: String,
+    label: egui::Id,
+    v: &mut T,
+    all: &[T],
+    name: impl Fn(&T) -> &'static str,
+) -> bool {
     let mut changed = false;
     let r = egui::ComboBox::from_id_salt(id).selected_text(name(v)).width(112.0).show_ui(ui, |ui| {
         for x in all {
@@ -492,7 +567,8 @@ pub fn settings_grid(ui: &mut egui::Ui, settings: &mut [Settings; 2], sides: usi
             ($name:literal, $field:ident, $ty:ty) => {{
                 let l = ui.label($name).id;
                 for i in 0..sides {
-                    c[i] |= grid_choice(ui, format!("{i}-{}", $name), l, &mut settings[i].$field, <$ty>::ALL, |v| v.name());
+                    c[i] |=
+                        grid_choice(ui, format!("{i}-{}", $name), l, &mut settings[i].$field, <$ty>::ALL, |v| v.name());
                 }
                 ui.end_row();
             }};
@@ -561,7 +637,13 @@ fn stats_grid(ui: &mut egui::Ui, stats: &[SideStats], has_reference: bool) {
             ui.end_row();
         };
         let height = |s: &SideStats| s.settings.height.max(1);
-        row(ui, "spp", &|s| if s.pass_rows > 0 { format!("{} (+{}/{} rows)", s.spp, s.pass_rows, height(s)) } else { s.spp.to_string() });
+        row(ui, "spp", &|s| {
+            if s.pass_rows > 0 {
+                format!("{} (+{}/{} rows)", s.spp, s.pass_rows, height(s))
+            } else {
+                s.spp.to_string()
+            }
+        });
         row(ui, "samples/s", &|s| format!("{:.2} M", s.samples_per_s / 1e6));
         row(ui, "GPU ms/frame", &|s| format!("{:.1}", s.gpu_ms));
         row(ui, "Mrays/s", &|s| format!("{:.2}", s.mrays_per_s));
@@ -594,7 +676,11 @@ fn legend(ui: &mut egui::Ui, view: View, range: [f32; 2]) {
         let c = display::false_colour(t).map(|v| (v * 255.0 + 0.5) as u8);
         let x0 = rect.left() + rect.width() * k as f32 / n as f32;
         let x1 = rect.left() + rect.width() * (k + 1) as f32 / n as f32 + 0.5;
-        painter.rect_filled(Rect::from_min_max(Pos2::new(x0, rect.top()), Pos2::new(x1, rect.bottom())), 0.0, Color32::from_rgb(c[0], c[1], c[2]));
+        painter.rect_filled(
+            Rect::from_min_max(Pos2::new(x0, rect.top()), Pos2::new(x1, rect.bottom())),
+            0.0,
+            Color32::from_rgb(c[0], c[1], c[2]),
+        );
     }
     let (tick_rect, _) = ui.allocate_exact_size(Vec2::new(rect.width(), 14.0), Sense::hover());
     let p2 = ui.painter_at(tick_rect.expand(8.0));
@@ -613,7 +699,13 @@ fn legend(ui: &mut egui::Ui, view: View, range: [f32; 2]) {
         } else {
             egui::Align2::CENTER_TOP
         };
-        p2.text(Pos2::new(x, tick_rect.top()), align, format!("1e{d}"), egui::FontId::monospace(10.0), ui.visuals().text_color());
+        p2.text(
+            Pos2::new(x, tick_rect.top()),
+            align,
+            format!("1e{d}"),
+            egui::FontId::monospace(10.0),
+            ui.visuals().text_color(),
+        );
         d += step;
     }
 }

@@ -135,7 +135,9 @@ impl ImageStats {
     pub fn from_partials(p: &[SideSums]) -> ImageStats {
         let mut s = [0f64; 7];
         for x in p {
-            for (acc, v) in s.iter_mut().zip([x.rel_se, x.rel_se_n, x.sq_err, x.rel_mse, x.err_n, x.nonfinite_px, x.sampled_px]) {
+            for (acc, v) in
+                s.iter_mut().zip([x.rel_se, x.rel_se_n, x.sq_err, x.rel_mse, x.err_n, x.nonfinite_px, x.sampled_px])
+            {
                 *acc += v as f64;
             }
         }
@@ -225,25 +227,72 @@ impl DisplayPass {
                 entry(7, rw),
             ],
         });
-        let pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("display"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("display"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         let pipelines = View::ALL
             .iter()
-            .map(|v| crate::shaders::compute_pipeline(&device, "display", &display_source(), "display_main", &[("VIEW", v.tag() as f64)], Some(&pipeline_layout)))
+            .map(|v| {
+                crate::shaders::compute_pipeline(
+                    &device,
+                    "display",
+                    &display_source(),
+                    "display_main",
+                    &[("VIEW", v.tag() as f64)],
+                    Some(&pipeline_layout),
+                )
+            })
             .collect::<Result<Vec<_>, _>>()?;
-        let stats_pipeline = crate::shaders::compute_pipeline(&device, "display stats", &display_source(), "stats_main", &[], Some(&pipeline_layout))?;
+        let stats_pipeline = crate::shaders::compute_pipeline(
+            &device,
+            "display stats",
+            &display_source(),
+            "stats_main",
+            &[],
+            Some(&pipeline_layout),
+        )?;
         let workgroups = (width.div_ceil(8), height.div_ceil(8));
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage,
+                mapped_at_creation: false,
+            })
         };
         let pixels = width as u64 * height as u64;
         let out = buffer("display out", pixels * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
         let partial_bytes = width as u64 * std::mem::size_of::<Partial>() as u64;
-        let partials = buffer("display partials", partial_bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let staging = buffer("display staging", pixels * 4 + partial_bytes, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-        let params = buffer("display params", std::mem::size_of::<DisplayParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let partials =
+            buffer("display partials", partial_bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let staging = buffer(
+            "display staging",
+            pixels * 4 + partial_bytes,
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        );
+        let params = buffer(
+            "display params",
+            std::mem::size_of::<DisplayParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let dummy_reference = buffer("no reference", 16, wgpu::BufferUsages::STORAGE);
-        Ok(DisplayPass { device, queue: ctx.queue.clone(), pipelines, stats_pipeline, layout, params, out, partials, staging, dummy_reference, width, height, workgroups })
+        Ok(DisplayPass {
+            device,
+            queue: ctx.queue.clone(),
+            pipelines,
+            stats_pipeline,
+            layout,
+            params,
+            out,
+            partials,
+            staging,
+            dummy_reference,
+            width,
+            height,
+            workgroups,
+        })
     }
 
     /// Records the display dispatch for rows `params.row_offset ..+ params.row_count`, the statistics
@@ -276,7 +325,10 @@ impl DisplayPass {
             ],
         });
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("display"), timestamp_writes: timestamps });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("display"),
+                timestamp_writes: timestamps,
+            });
             pass.set_pipeline(&self.pipelines[(params.view as usize).min(self.pipelines.len() - 1)]);
             pass.set_bind_group(0, &group, &[]);
             if row_count > 0 {
@@ -290,10 +342,22 @@ impl DisplayPass {
         let image_bytes = self.width as u64 * self.height as u64 * 4;
         let row_bytes = self.width as u64 * 4;
         if row_count > 0 {
-            enc.copy_buffer_to_buffer(&self.out, row_offset as u64 * row_bytes, &self.staging, row_offset as u64 * row_bytes, row_count as u64 * row_bytes);
+            enc.copy_buffer_to_buffer(
+                &self.out,
+                row_offset as u64 * row_bytes,
+                &self.staging,
+                row_offset as u64 * row_bytes,
+                row_count as u64 * row_bytes,
+            );
         }
         if stats {
-            enc.copy_buffer_to_buffer(&self.partials, 0, &self.staging, image_bytes, self.partials.size().min(self.staging.size() - image_bytes));
+            enc.copy_buffer_to_buffer(
+                &self.partials,
+                0,
+                &self.staging,
+                image_bytes,
+                self.partials.size().min(self.staging.size() - image_bytes),
+            );
         }
     }
 
@@ -314,7 +378,8 @@ impl DisplayPass {
             let data = self.staging.get_mapped_range(..).map_err(|e| GpuError::Map(format!("{e:?}")))?;
             let rgba = data[..image_bytes].to_vec();
             let n = self.width as usize;
-            let partials: Vec<Partial> = bytemuck::pod_collect_to_vec(&data[image_bytes..image_bytes + n * std::mem::size_of::<Partial>()]);
+            let partials: Vec<Partial> =
+                bytemuck::pod_collect_to_vec(&data[image_bytes..image_bytes + n * std::mem::size_of::<Partial>()]);
             let a: Vec<SideSums> = partials.iter().map(|p| p.a).collect();
             let b: Vec<SideSums> = partials.iter().map(|p| p.b).collect();
             DisplayOutput { rgba, stats: stats.then(|| [ImageStats::from_partials(&a), ImageStats::from_partials(&b)]) }

@@ -277,9 +277,15 @@ pub fn spawn(ctx: GpuContext, config: EngineConfig, repaint: Arc<dyn Fn() + Send
         .name("mislab-render".into())
         .spawn(move || {
             let shared3 = shared2.clone();
-            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || engine_main(ctx, config, rx, shared2, repaint)));
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
+                engine_main(ctx, config, rx, shared2, repaint)
+            }));
             if let Err(p) = result {
-                let what = p.downcast_ref::<String>().cloned().or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default();
+                let what = p
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
                 let mut s = shared3.lock().unwrap_or_else(|p| p.into_inner());
                 s.fatal = Some(format!("the render thread failed: {what}"));
             }
@@ -288,7 +294,13 @@ pub fn spawn(ctx: GpuContext, config: EngineConfig, repaint: Arc<dyn Fn() + Send
     EngineHandle { tx, shared, thread: Some(thread) }
 }
 
-fn engine_main(ctx: GpuContext, config: EngineConfig, rx: Receiver<Command>, shared: Arc<Mutex<Shared>>, repaint: Arc<dyn Fn() + Send + Sync>) {
+fn engine_main(
+    ctx: GpuContext,
+    config: EngineConfig,
+    rx: Receiver<Command>,
+    shared: Arc<Mutex<Shared>>,
+    repaint: Arc<dyn Fn() + Send + Sync>,
+) {
     let mut engine = match Engine::new(ctx, config, shared.clone(), repaint.clone()) {
         Ok(e) => e,
         Err(e) => {
@@ -339,7 +351,13 @@ fn compile_worker(
 ) {
     let warm = warm.and_then(|c| {
         let gs = GpuScene::upload(&c, SceneData::build(&Scene::default())).ok()?;
-        let r = Renderer::new_unprepared(&c, &gs, Camera::default(), Settings { width: 8, height: 8, ..Settings::default() }).ok()?;
+        let r = Renderer::new_unprepared(
+            &c,
+            &gs,
+            Camera::default(),
+            Settings { width: 8, height: 8, ..Settings::default() },
+        )
+        .ok()?;
         Some((c, gs, r))
     });
     let mut warm = warm;
@@ -379,7 +397,8 @@ fn compile_worker(
             }
         }
         let constants = job.key.constants();
-        let result = crate::shaders::compute_pipeline(&device, "render", &source, "render_main", &constants, Some(&layout));
+        let result =
+            crate::shaders::compute_pipeline(&device, "render", &source, "render_main", &constants, Some(&layout));
         if done.send((job.key, result, t.elapsed().as_secs_f64())).is_err() {
             return;
         }
@@ -560,9 +579,15 @@ fn scene_centre(scene: &Scene) -> glam::Vec3 {
 }
 
 impl Engine {
-    fn new(ctx: GpuContext, config: EngineConfig, shared: Arc<Mutex<Shared>>, repaint: Arc<dyn Fn() + Send + Sync>) -> Result<Engine, String> {
+    fn new(
+        ctx: GpuContext,
+        config: EngineConfig,
+        shared: Arc<Mutex<Shared>>,
+        repaint: Arc<dyn Fn() + Send + Sync>,
+    ) -> Result<Engine, String> {
         let (w, h) = (config.settings[0].width, config.settings[0].height);
-        let gs = GpuScene::upload(&ctx, SceneData::build(&config.scene)).map_err(|e| format!("{}: {e}", config.scene_name))?;
+        let gs = GpuScene::upload(&ctx, SceneData::build(&config.scene))
+            .map_err(|e| format!("{}: {e}", config.scene_name))?;
         let camera = config.scene.camera.clone();
         let mut sides = Vec::new();
         for s in &config.settings {
@@ -570,7 +595,8 @@ impl Engine {
         }
         let display = DisplayPass::new(&ctx, w, h)?;
         let wanted: Wanted = Arc::new(Mutex::new(HashSet::new()));
-        let (jobs, compiled, worker_stop) = Self::start_worker(&ctx, &sides[0].renderer, config.warm_device, wanted.clone());
+        let (jobs, compiled, worker_stop) =
+            Self::start_worker(&ctx, &sides[0].renderer, config.warm_device, wanted.clone());
         let lost = Arc::new(AtomicBool::new(false));
         let gpu_error = Arc::new(Mutex::new(None));
         Self::watch_device(&ctx, &lost, &gpu_error);
@@ -628,11 +654,13 @@ impl Engine {
         layout_of: &Renderer,
         warm_device: bool,
         wanted: Wanted,
-    ) -> (Sender<CompileJob>, Receiver<(PipelineKey, Result<wgpu::ComputePipeline, String>, f64)>, Arc<AtomicBool>) {
+    ) -> (Sender<CompileJob>, Receiver<(PipelineKey, Result<wgpu::ComputePipeline, String>, f64)>, Arc<AtomicBool>)
+    {
         let (jobs_tx, jobs_rx) = mpsc::channel();
         let (done_tx, done_rx) = mpsc::channel();
         let stop = Arc::new(AtomicBool::new(false));
-        let warm = if warm_device { GpuContext::from_adapter(ctx.instance.clone(), ctx.adapter.clone()).ok() } else { None };
+        let warm =
+            if warm_device { GpuContext::from_adapter(ctx.instance.clone(), ctx.adapter.clone()).ok() } else { None };
         let device = ctx.device.clone();
         let layout = layout_of.pipeline_layout().clone();
         let stop2 = stop.clone();
@@ -645,7 +673,12 @@ impl Engine {
 
     fn warm_renderer(ctx: &GpuContext) -> Result<(GpuScene, Renderer), String> {
         let gs = GpuScene::upload(ctx, SceneData::build(&Scene::default()))?;
-        let r = Renderer::new_unprepared(ctx, &gs, Camera::default(), Settings { width: 8, height: 8, ..Settings::default() })?;
+        let r = Renderer::new_unprepared(
+            ctx,
+            &gs,
+            Camera::default(),
+            Settings { width: 8, height: 8, ..Settings::default() },
+        )?;
         Ok((gs, r))
     }
 
@@ -670,7 +703,11 @@ impl Engine {
         if !ctx.timestamps {
             return None;
         }
-        let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("viewer timestamps"), ty: wgpu::QueryType::Timestamp, count: 6 });
+        let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("viewer timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 6,
+        });
         let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("timestamps resolve"),
             size: 48,
@@ -687,7 +724,11 @@ impl Engine {
     }
 
     fn active(&self) -> usize {
-        if self.compare { 2 } else { 1 }
+        if self.compare {
+            2
+        } else {
+            1
+        }
     }
 
     fn shared(&self) -> MutexGuard<'_, Shared> {
@@ -842,7 +883,8 @@ impl Engine {
                 s.validate()?;
                 let i = side as usize;
                 let old = &self.settings[i];
-                let same_estimator = Settings { exposure: 0.0, width: 0, height: 0, ..old.clone() } == Settings { exposure: 0.0, width: 0, height: 0, ..s.clone() };
+                let same_estimator = Settings { exposure: 0.0, width: 0, height: 0, ..old.clone() }
+                    == Settings { exposure: 0.0, width: 0, height: 0, ..s.clone() };
                 self.settings[i] = s.clone();
                 if !same_estimator {
                     self.sides[i].set_settings(s);
@@ -878,7 +920,10 @@ impl Engine {
                     Ok(sc) => {
                         let warnings = sc.warnings.len();
                         self.set_scene(sc, name.clone())?;
-                        self.message(format!("opened {name}{}", if warnings > 0 { format!(" ({warnings} warnings)") } else { String::new() }));
+                        self.message(format!(
+                            "opened {name}{}",
+                            if warnings > 0 { format!(" ({warnings} warnings)") } else { String::new() }
+                        ));
                     }
                     Err(e) => self.message(format!("could not open the scene: {e}")),
                 }
@@ -1065,7 +1110,8 @@ impl Engine {
         self.recoveries += 1;
         log::warn!("render device error: {why}");
         if self.recoveries > 3 {
-            self.shared().fatal = Some(format!("the GPU device failed repeatedly ({why}); close the window and restart mislab"));
+            self.shared().fatal =
+                Some(format!("the GPU device failed repeatedly ({why}); close the window and restart mislab"));
             (self.repaint)();
             return;
         }
@@ -1080,7 +1126,8 @@ impl Engine {
             let (w, h) = (self.settings[0].width, self.settings[0].height);
             let display = DisplayPass::new(&ctx, w, h)?;
             self.worker_stop.store(true, Ordering::SeqCst);
-            let (jobs, compiled, stop) = Self::start_worker(&ctx, &sides[0].renderer, self.warm_device, self.wanted.clone());
+            let (jobs, compiled, stop) =
+                Self::start_worker(&ctx, &sides[0].renderer, self.warm_device, self.wanted.clone());
             let lost = Arc::new(AtomicBool::new(false));
             Self::watch_device(&ctx, &lost, &self.gpu_error);
             self.timestamps = Self::make_timestamps(&ctx);
@@ -1127,7 +1174,8 @@ impl Engine {
         }
         let n = self.active();
         let budget = FRAME_BUDGET_S / n as f64;
-        let mut enc = self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer frame") });
+        let mut enc =
+            self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer frame") });
         let mut dispatches: Vec<(usize, Dispatch)> = Vec::new();
         for i in 0..n {
             if !self.choose_pipeline(i) {
@@ -1182,7 +1230,8 @@ impl Engine {
         };
         // Redraw only the rows rendered this frame, unless everything changed (a restart shows the
         // preview everywhere; display options change every pixel).
-        let full = self.frames == 0 || self.display_dirty() || dispatches.iter().any(|(_, d)| matches!(d, Dispatch::Preview));
+        let full =
+            self.frames == 0 || self.display_dirty() || dispatches.iter().any(|(_, d)| matches!(d, Dispatch::Preview));
         let params = if full {
             params
         } else {
@@ -1205,7 +1254,11 @@ impl Engine {
         if stats {
             self.last_stats = Instant::now();
         }
-        let ts = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites { query_set: &t.set, beginning_of_pass_write_index: Some(4), end_of_pass_write_index: Some(5) });
+        let ts = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
+            query_set: &t.set,
+            beginning_of_pass_write_index: Some(4),
+            end_of_pass_write_index: Some(5),
+        });
         let inputs = DisplayInputs {
             accum: [self.sides[0].renderer.accum_buffer(), self.sides[b].renderer.accum_buffer()],
             preview: [self.sides[0].preview.accum_buffer(), self.sides[b].preview.accum_buffer()],
@@ -1318,7 +1371,11 @@ impl Engine {
                 spp: r.samples,
                 pass_rows: side.pass_row,
                 samples_per_s: if side.render_seconds > 0.0 { side.pixel_samples / side.render_seconds } else { 0.0 },
-                mrays_per_s: if side.render_seconds > 0.0 { r.rays_total as f64 / side.render_seconds / 1e6 } else { 0.0 },
+                mrays_per_s: if side.render_seconds > 0.0 {
+                    r.rays_total as f64 / side.render_seconds / 1e6
+                } else {
+                    0.0
+                },
                 gpu_ms: side.last_gpu_ms,
                 image: self.image_stats[i],
                 nonfinite_samples: r.nonfinite_total,

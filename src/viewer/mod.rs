@@ -13,8 +13,8 @@ use crate::gpu::GpuContext;
 use crate::scene::{self, Environment, LoadOptions, Scene};
 use crate::settings::{Settings, Strategy};
 use app::Viewer;
-use eframe::{egui, egui_wgpu};
 use display::View;
+use eframe::{egui, egui_wgpu};
 use engine::{DisplayOptions, EngineConfig};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -81,7 +81,10 @@ pub struct ViewArgs {
 
 fn parse_view(s: &str) -> Result<View, String> {
     View::ALL.iter().copied().find(|v| v.name() == s).ok_or_else(|| {
-        format!("unknown view '{s}' (expected one of: {})", View::ALL.iter().map(|v| v.name()).collect::<Vec<_>>().join(", "))
+        format!(
+            "unknown view '{s}' (expected one of: {})",
+            View::ALL.iter().map(|v| v.name()).collect::<Vec<_>>().join(", ")
+        )
     })
 }
 
@@ -106,7 +109,8 @@ pub fn load_scene(args: &ViewArgs) -> Result<Scene, String> {
     if let Some(env) = &args.env {
         let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| e.to_string())?;
         scene.warnings.extend(warnings);
-        scene.environment = Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
+        scene.environment =
+            Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
     }
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", args.scene);
@@ -116,10 +120,17 @@ pub fn load_scene(args: &ViewArgs) -> Result<Scene, String> {
 
 /// The engine configuration and the panel's starting state for `args`.
 pub fn config(args: &ViewArgs, scene: Scene) -> Result<(EngineConfig, [Settings; 2], DisplayOptions), String> {
-    let a = Settings { width: args.width, height: args.height, strategy: args.strategy, exposure: args.exposure, ..Settings::default() };
+    let a = Settings {
+        width: args.width,
+        height: args.height,
+        strategy: args.strategy,
+        exposure: args.exposure,
+        ..Settings::default()
+    };
     a.validate()?;
     let b = Settings { strategy: args.compare.unwrap_or(Strategy::Bsdf), ..a.clone() };
-    let display = DisplayOptions { view: args.view, tonemap: args.tonemap, exposure: args.exposure, ..DisplayOptions::default() };
+    let display =
+        DisplayOptions { view: args.view, tonemap: args.tonemap, exposure: args.exposure, ..DisplayOptions::default() };
     let settings = [a, b];
     let config = EngineConfig {
         scene,
@@ -194,7 +205,11 @@ impl App {
             return self.finish(ctx, Err(f));
         }
         if shot.started.elapsed() > SCREENSHOT_TIMEOUT {
-            let msg = format!("--screenshot: only {frames} of {} frames after {} s", shot.frames, SCREENSHOT_TIMEOUT.as_secs());
+            let msg = format!(
+                "--screenshot: only {frames} of {} frames after {} s",
+                shot.frames,
+                SCREENSHOT_TIMEOUT.as_secs()
+            );
             return self.finish(ctx, Err(msg));
         }
         if frames > 0 && shot.rendering_since.is_none() {
@@ -234,7 +249,10 @@ impl App {
                 let [w, h] = image.size;
                 let bytes: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
                 let r = match image::RgbaImage::from_raw(w as u32, h as u32, bytes) {
-                    Some(img) => image::DynamicImage::ImageRgba8(img).to_rgb8().save(&path).map_err(|e| format!("{}: {e}", path.display())),
+                    Some(img) => image::DynamicImage::ImageRgba8(img)
+                        .to_rgb8()
+                        .save(&path)
+                        .map_err(|e| format!("{}: {e}", path.display())),
                     None => Err("the screenshot has an unexpected size".into()),
                 };
                 *saved.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
@@ -271,7 +289,11 @@ impl App {
         if !self.ui_cpu.is_empty() {
             let mut c = self.ui_cpu.clone();
             c.sort_by(|a, b| a.total_cmp(b));
-            eprintln!("UI frame CPU time (eframe): median {:.1} ms, max {:.1} ms", c[c.len() / 2] * 1e3, c[c.len() - 1] * 1e3);
+            eprintln!(
+                "UI frame CPU time (eframe): median {:.1} ms, max {:.1} ms",
+                c[c.len() / 2] * 1e3,
+                c[c.len() - 1] * 1e3
+            );
         }
         let lat = &self.viewer.toggle_latencies_ms;
         if !lat.is_empty() {
@@ -331,12 +353,17 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     setup.instance_descriptor.backends = wgpu::Backends::VULKAN;
     let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default().with_title(format!("mislab view — {}", args.scene)).with_inner_size([width, height]),
+        viewport: egui::ViewportBuilder::default()
+            .with_title(format!("mislab view — {}", args.scene))
+            .with_inner_size([width, height]),
         renderer: eframe::Renderer::Wgpu,
         wgpu_options: egui_wgpu::WgpuConfiguration {
             wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup),
             // Without vsync: on a software rasterizer a frame should be shown as soon as it is drawn.
-            surface: egui_wgpu::SurfaceConfig { present_mode: wgpu::PresentMode::AutoNoVsync, desired_maximum_frame_latency: Some(1) },
+            surface: egui_wgpu::SurfaceConfig {
+                present_mode: wgpu::PresentMode::AutoNoVsync,
+                desired_maximum_frame_latency: Some(1),
+            },
             ..Default::default()
         },
         ..Default::default()
