@@ -4,50 +4,39 @@
 //! ratio is of the summed samples over the summed seconds. `cargo bench --bench specialization`
 //! (MISLAB_BENCH_SECONDS per round, default 4; MISLAB_BENCH_ROUNDS, default 3; MISLAB_BENCH_SIZE, default 512).
 
+mod common;
+
+use common::env_or;
 use mislab::features::Features;
-use mislab::gpu::GpuContext;
 use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::progressive::{self, Budget};
 use mislab::render::Renderer;
-use mislab::scene::{self, envmap, Environment, LoadOptions};
 use mislab::settings::{Mode, Settings};
 use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
-    std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(default)
-}
 
 fn main() {
     let seconds: f64 = env_or("MISLAB_BENCH_SECONDS", 4.0);
     let rounds: u32 = env_or("MISLAB_BENCH_ROUNDS", 3);
     let size: u32 = env_or("MISLAB_BENCH_SIZE", 512);
-    let ctx = GpuContext::new().expect("a Vulkan adapter (apt-get install mesa-vulkan-drivers)");
+    let ctx = common::gpu();
     println!(
         "device: {} ({:?}); {size}x{size}, {rounds} rounds of {seconds} s per pipeline, alternating",
         ctx.info.name, ctx.info.device_type
     );
-    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata");
-    let helmet = format!("{shared}/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
-    let sky = format!("{shared}/env/hdr/noon_grass_1k.hdr");
-    let cases: Vec<(&str, String, Mode, bool)> = vec![
-        ("cornell-box", "cornell-box".into(), Mode::Path, false),
-        ("furnace", "furnace".into(), Mode::Path, false),
-        ("veach-mis", "veach-mis".into(), Mode::Direct, false),
-        ("DamagedHelmet + noon_grass", helmet, Mode::Path, true),
+    let cases = [
+        ("cornell-box", Mode::Path),
+        ("furnace", Mode::Path),
+        ("veach-mis", Mode::Direct),
+        (common::HELMET, Mode::Path),
     ];
     println!(
         "{:<28} {:>6} {:>10} {:>12} {:>7} {:>14}  features",
         "scene", "mode", "spec Ms/s", "generic Ms/s", "ratio", "compile s s/g"
     );
     let mut generic: Option<wgpu::ComputePipeline> = None;
-    for (label, name, mode, env) in cases {
-        let mut s = scene::load(&name, &LoadOptions::default()).expect("scene");
-        if env {
-            let (map, _) = envmap::load_envmap(std::path::Path::new(&sky)).expect("env map");
-            s.environment = Environment::Map { map: Arc::new(map), scale: 1.0, rotation: 0.0 };
-        }
+    for (label, mode) in cases {
+        let s = common::load(label);
         let data = SceneData::build(&s);
         let features = Features::of(&data).describe();
         let gs = GpuScene::upload(&ctx, data).expect("upload");

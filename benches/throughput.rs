@@ -2,42 +2,34 @@
 //! bytes per triangle. `cargo bench --bench throughput` (set MISLAB_BENCH_SECONDS to change the time per
 //! configuration; default 10 s). Speed is measured here, never in tests.
 
-use mislab::gpu::GpuContext;
+mod common;
+
 use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::progressive::{self, Budget};
 use mislab::render::Renderer;
-use mislab::scene::{self, envmap, Environment, LoadOptions};
 use mislab::settings::{Mode, Settings};
 use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 use std::time::Duration;
 
 fn main() {
-    let seconds: f64 = std::env::var("MISLAB_BENCH_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(10.0);
-    let ctx = GpuContext::new().expect("a Vulkan adapter (apt-get install mesa-vulkan-drivers)");
+    let seconds: f64 = common::env_or("MISLAB_BENCH_SECONDS", 10.0);
+    let ctx = common::gpu();
     println!("device: {} ({:?}); {seconds} s per configuration, 512x512", ctx.info.name, ctx.info.device_type);
-    let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata");
-    let helmet = format!("{shared}/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
-    let sky = format!("{shared}/env/hdr/noon_grass_1k.hdr");
-    let cases: Vec<(&str, String, Mode, bool)> = vec![
-        ("veach-mis", "veach-mis".into(), Mode::Direct, false),
-        ("veach-mis", "veach-mis".into(), Mode::Path, false),
-        ("cornell-box", "cornell-box".into(), Mode::Direct, false),
-        ("cornell-box", "cornell-box".into(), Mode::Path, false),
-        ("furnace", "furnace".into(), Mode::Path, false),
-        ("area-vs-cosine", "area-vs-cosine".into(), Mode::Direct, false),
-        ("DamagedHelmet + noon_grass", helmet, Mode::Path, true),
+    let cases = [
+        ("veach-mis", Mode::Direct),
+        ("veach-mis", Mode::Path),
+        ("cornell-box", Mode::Direct),
+        ("cornell-box", Mode::Path),
+        ("furnace", Mode::Path),
+        ("area-vs-cosine", Mode::Direct),
+        (common::HELMET, Mode::Path),
     ];
     println!(
         "{:<28} {:>6} {:>10} {:>10} {:>8} {:>10} {:>9} {:>9}",
         "scene", "mode", "tris", "BVH ms", "B/tri", "spp", "Msamp/s", "Mrays/s"
     );
-    for (label, name, mode, env) in cases {
-        let mut s = scene::load(&name, &LoadOptions::default()).expect("scene");
-        if env {
-            let (map, _) = envmap::load_envmap(std::path::Path::new(&sky)).expect("env map");
-            s.environment = Environment::Map { map: Arc::new(map), scale: 1.0, rotation: 0.0 };
-        }
+    for (label, mode) in cases {
+        let s = common::load(label);
         let data = SceneData::build(&s);
         let (bvh_ms, bpt) = (data.bvh_seconds * 1e3, data.bvh_bytes() as f64 / s.triangle_count().max(1) as f64);
         let gs = GpuScene::upload(&ctx, data).expect("upload");

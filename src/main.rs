@@ -265,17 +265,8 @@ fn unreachable_light_warning(data: &SceneData, s: &Settings) -> Option<String> {
 fn stress(filter: Option<&str>) -> Result<u8, Failure> {
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
-    let outcomes = mislab::stress::run(&ctx, filter, |o| {
-        eprintln!(
-            "{} {:<12} {:<50} NaN/Inf {:>3}  {}",
-            if o.pass { "pass" } else { "FAIL" },
-            o.group,
-            o.name,
-            o.nonfinite,
-            o.detail
-        );
-    })
-    .map_err(bad)?;
+    let outcomes =
+        mislab::stress::run(&ctx, filter, |o| eprintln!("{}", mislab::stress::progress_line(o))).map_err(bad)?;
     println!("{}", mislab::stress::table(&outcomes));
     let failed = outcomes.iter().filter(|o| !o.pass).count();
     println!(

@@ -814,6 +814,18 @@ fn judge(c: &Case, film: &Film, nonfinite: u64, seconds: f64, means: &HashMap<St
     o
 }
 
+/// One line per outcome, as `mislab stress` and the test print them while the suite runs.
+pub fn progress_line(o: &Outcome) -> String {
+    format!(
+        "{} {:<12} {:<50} NaN/Inf {:>3}  {}",
+        if o.pass { "pass" } else { "FAIL" },
+        o.group,
+        o.name,
+        o.nonfinite,
+        o.detail
+    )
+}
+
 /// The outcomes as a Markdown table.
 pub fn table(outcomes: &[Outcome]) -> String {
     let mut s = String::from(

@@ -366,21 +366,8 @@ fn sphere_irradiance(p: DVec3, n: DVec3, c: DVec3, r: f64, l: f64) -> f64 {
     std::f64::consts::PI * l * (r / d).powi(2) * (v.dot(n) / d)
 }
 
-/// Irradiance at p (normal n) from a Lambertian polygon of radiance L wholly above p's horizon and facing p
-/// (Lambert 1760; Arvo 1995 eq. 3): E = L/2 · |Σ_i Θ_i · n·(v_i × v_{i+1})/|v_i × v_{i+1}||, v_i the unit
-/// directions from p to the vertices, Θ_i the angle between consecutive ones.
-fn polygon_irradiance(p: DVec3, n: DVec3, verts: &[DVec3], l: f64) -> f64 {
-    let k = verts.len();
-    let mut sum = 0.0;
-    for i in 0..k {
-        let a = (verts[i] - p).normalize();
-        let b = (verts[(i + 1) % k] - p).normalize();
-        let c = a.cross(b);
-        let theta = a.dot(b).clamp(-1.0, 1.0).acos();
-        sum += theta * n.dot(c) / c.length();
-    }
-    0.5 * l * sum.abs()
-}
+/// Irradiance at p (normal n) from a Lambertian polygon (Lambert's formula; the stress suite's closed form).
+use mislab::stress::polygon_irradiance;
 
 /// Radiance reflected by the Lambert plane at p towards any direction: ρ/π·(E_sphere + E_quad).
 fn plane_radiance(p: DVec3) -> f64 {

@@ -6,17 +6,8 @@ mod common;
 #[test]
 fn every_stress_case_is_finite_and_right() {
     let ctx = common::gpu();
-    let outcomes = mislab::stress::run(&ctx, None, |o| {
-        eprintln!(
-            "{} {:<12} {:<50} NaN/Inf {:>3}  {}",
-            if o.pass { "pass" } else { "FAIL" },
-            o.group,
-            o.name,
-            o.nonfinite,
-            o.detail
-        )
-    })
-    .unwrap_or_else(|e| panic!("the stress suite could not run: {e}"));
+    let outcomes = mislab::stress::run(&ctx, None, |o| eprintln!("{}", mislab::stress::progress_line(o)))
+        .unwrap_or_else(|e| panic!("the stress suite could not run: {e}"));
     eprintln!("{}", mislab::stress::table(&outcomes));
     assert!(outcomes.len() >= 40, "the issue asks for at least 40 stress configurations, found {}", outcomes.len());
     let analytic = outcomes.iter().filter(|o| o.expected.is_some()).count();
