@@ -1,4 +1,4 @@
-//! The numerical stress suite (src/stress.rs): every case must count 0 NaN/Inf samples on the device and,
+//! The numerical stress suite (src/stress/): every case must count 0 NaN/Inf samples on the device and,
 //! where an answer is known (analytic, or the same image as its unstressed twin), reach it.
 
 mod common;
