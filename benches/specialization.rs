@@ -9,11 +9,9 @@ mod common;
 use common::env_or;
 use mislab::features::Features;
 use mislab::gpu_scene::{GpuScene, SceneData};
-use mislab::progressive::{self, Budget};
 use mislab::render::Renderer;
 use mislab::settings::{Mode, Settings};
-use std::sync::atomic::AtomicBool;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 fn main() {
     let seconds: f64 = env_or("MISLAB_BENCH_SECONDS", 4.0);
@@ -58,14 +56,7 @@ fn main() {
             for (k, spec) in [true, false].into_iter().enumerate() {
                 r.set_specialize(spec).expect("pipeline");
                 r.reset();
-                let stats = progressive::run(
-                    &ctx,
-                    &mut r,
-                    Budget::Time(Duration::from_secs_f64(seconds)),
-                    &AtomicBool::new(false),
-                    |_, _| {},
-                )
-                .expect("render");
+                let stats = common::render_for(&ctx, &mut r, seconds);
                 totals[k].0 += stats.spp as f64 * (size * size) as f64;
                 totals[k].1 += stats.seconds;
             }

@@ -5,11 +5,8 @@
 mod common;
 
 use mislab::gpu_scene::{GpuScene, SceneData};
-use mislab::progressive::{self, Budget};
 use mislab::render::Renderer;
 use mislab::settings::{Mode, Settings};
-use std::sync::atomic::AtomicBool;
-use std::time::Duration;
 
 fn main() {
     let seconds: f64 = common::env_or("MISLAB_BENCH_SECONDS", 10.0);
@@ -35,14 +32,7 @@ fn main() {
         let gs = GpuScene::upload(&ctx, data).expect("upload");
         let settings = Settings { mode, ..Settings::default() };
         let mut r = Renderer::new(&ctx, &gs, s.camera.clone(), settings).expect("renderer");
-        let stats = progressive::run(
-            &ctx,
-            &mut r,
-            Budget::Time(Duration::from_secs_f64(seconds)),
-            &AtomicBool::new(false),
-            |_, _| {},
-        )
-        .expect("render");
+        let stats = common::render_for(&ctx, &mut r, seconds);
         let samples = stats.spp as f64 * 512.0 * 512.0;
         println!(
             "{:<28} {:>6} {:>10} {:>10.1} {:>8.0} {:>10} {:>9.3} {:>9.3}",

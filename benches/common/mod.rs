@@ -2,8 +2,12 @@
 //! ../shared/testdata) and their environment variables.
 
 use mislab::gpu::GpuContext;
+use mislab::progressive::{self, Budget, RenderStats};
+use mislab::render::Renderer;
 use mislab::scene::{self, envmap, Environment, LoadOptions, Scene};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
+use std::time::Duration;
 
 /// `name` parsed from the environment, or `default`.
 pub fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
@@ -30,4 +34,10 @@ pub fn load(label: &str) -> Scene {
     let (map, _) = envmap::load_envmap(std::path::Path::new(&sky)).expect("env map");
     s.environment = Environment::Map { map: Arc::new(map), scale: 1.0, rotation: 0.0 };
     s
+}
+
+/// Renders progressively for `seconds` (pipelines already built), as `mislab render --time` does.
+pub fn render_for(ctx: &GpuContext, r: &mut Renderer, seconds: f64) -> RenderStats {
+    progressive::run(ctx, r, Budget::Time(Duration::from_secs_f64(seconds)), &AtomicBool::new(false), |_, _| {})
+        .expect("render")
 }
