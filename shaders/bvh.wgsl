@@ -108,22 +108,20 @@ fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, 
     let a = tri_vertex(r, v0);
     let b = tri_vertex(r, v1);
     let c = tri_vertex(r, v2);
-    let u = tri_edge(c.xy, b.xy);
-    let v = tri_edge(a.xy, c.xy);
-    let w = tri_edge(b.xy, a.xy);
-    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return vec4<f32>(0.0);
-    }
+    return tri_hit(tri_edge(c.xy, b.xy), tri_edge(a.xy, c.xy), tri_edge(b.xy, a.xy), a.z, b.z, c.z, t_max);
+}
+
+/// The end of the watertight test, from the edge functions u, v, w (opposite v0, v1, v2) and the sheared z of the
+/// vertices. Baked meshes (src/baked.rs) compute each shared vertex and edge once per ray and call this per
+/// triangle: the same values, bit for bit, as `intersect_triangle`.
+fn tri_hit(u: f32, v: f32, w: f32, az: f32, bz: f32, cz: f32, t_max: f32) -> vec4<f32> {
+    // Branch-free: lavapipe runs both sides of every branch anyway, and selects are cheaper than its masks.
+    let outside = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
     let det = u + v + w;
-    if det == 0.0 {
-        return vec4<f32>(0.0);
-    }
     let inv_det = 1.0 / det;
-    let t = (u * a.z + v * b.z + w * c.z) * inv_det;
-    if !(t > 0.0 && t < t_max) {
-        return vec4<f32>(0.0);
-    }
-    return vec4<f32>(t, v * inv_det, w * inv_det, 1.0);
+    let t = (u * az + v * bz + w * cz) * inv_det;
+    let hit = !outside && det != 0.0 && t > 0.0 && t < t_max;
+    return select(vec4<f32>(0.0), vec4<f32>(t, v * inv_det, w * inv_det, 1.0), hit);
 }
 
 /// Ray–sphere test, the cancellation-free form of Haines et al. 2019, "Precision Improvements for Ray/Sphere
@@ -137,9 +135,7 @@ fn intersect_sphere(o: vec3<f32>, d: vec3<f32>, center: vec3<f32>, radius: f32, 
     let l = f + (b / a) * d;
     let r2 = radius * radius;
     let disc = r2 - dot(l, l);
-    if !(disc >= 0.0) {
-        return vec4<f32>(0.0);
-    }
+    // Branch-free (see tri_hit): for disc < 0 the square root is NaN and every comparison below fails.
     let q = b + select(1.0, -1.0, b < 0.0) * sqrt(a * disc);
     let c = dot(f, f) - r2;
     let t0 = c / q;
@@ -147,33 +143,34 @@ fn intersect_sphere(o: vec3<f32>, d: vec3<f32>, center: vec3<f32>, radius: f32, 
     // select(), not min/max: min(NaN, x) = x on lavapipe would turn a NaN root into a hit.
     let near = select(t1, t0, t0 < t1);
     let far = select(t0, t1, t0 < t1);
-    if near > 0.0 && near < t_max {
-        return vec4<f32>(near, 0.0, 0.0, 1.0);
-    }
-    if far > 0.0 && far < t_max {
-        return vec4<f32>(far, 0.0, 0.0, 1.0);
-    }
-    return vec4<f32>(0.0);
+    let near_ok = near > 0.0 && near < t_max;
+    let far_ok = far > 0.0 && far < t_max;
+    let hit = disc >= 0.0 && (near_ok || far_ok);
+    return select(vec4<f32>(0.0), vec4<f32>(select(far, near, near_ok), 0.0, 0.0, 1.0), hit);
 }
 
 /// Ray–parallelogram test: the plane of corner + s·edge_u + t·edge_v, then (s, t) from cross products with the
 /// normal n = edge_u × edge_v. Returns (t, s, t_param, 1) for a hit with s, t_param ∈ [0, 1], w = 0 for a miss.
 fn intersect_quad(o: vec3<f32>, d: vec3<f32>, q: Quad, t_max: f32) -> vec4<f32> {
     let n = cross(q.edge_u, q.edge_v);
-    let denom = dot(n, d);
-    let rel_o = o - q.corner;
-    let t = -dot(n, rel_o) / denom;
-    if !(t > 0.0 && t < t_max) || denom == 0.0 {
-        return vec4<f32>(0.0);
-    }
-    let p = rel_o + t * d;
     let inv_nn = 1.0 / dot(n, n);
-    let s = dot(cross(p, q.edge_v), n) * inv_nn;
-    let tt = dot(cross(q.edge_u, p), n) * inv_nn;
-    if !(s >= 0.0 && s <= 1.0 && tt >= 0.0 && tt <= 1.0) {
-        return vec4<f32>(0.0);
-    }
-    return vec4<f32>(t, s, tt, 1.0);
+    return intersect_parallelogram(o, d, q.corner, n, cross(q.edge_v, n) * inv_nn, cross(n, q.edge_u) * inv_nn, t_max);
+}
+
+/// `intersect_quad` with the per-quad vectors precomputed (baked scenes write them as literals): the normal n and
+/// the dual axes s_axis = (edge_v × n)/|n|², t_axis = (n × edge_u)/|n|², so that for a point p on the plane
+/// (relative to the corner) s = p·s_axis and t = p·t_axis (the triple products (p × edge_v)·n/|n|² and
+/// (edge_u × p)·n/|n|²).
+fn intersect_parallelogram(o: vec3<f32>, d: vec3<f32>, corner: vec3<f32>, n: vec3<f32>, s_axis: vec3<f32>, t_axis: vec3<f32>, t_max: f32) -> vec4<f32> {
+    let denom = dot(n, d);
+    let rel_o = o - corner;
+    let t = -dot(n, rel_o) / denom;
+    let p = rel_o + t * d;
+    let s = dot(p, s_axis);
+    let tt = dot(p, t_axis);
+    // Branch-free (see tri_hit); ordered comparisons fail for the NaN/∞ of denom = 0.
+    let hit = t > 0.0 && t < t_max && denom != 0.0 && s >= 0.0 && s <= 1.0 && tt >= 0.0 && tt <= 1.0;
+    return select(vec4<f32>(0.0), vec4<f32>(t, s, tt, 1.0), hit);
 }
 
 /// Intersects one primitive reference (kind << 30 | index); (t, b1, b2, 1) for a hit in (0, t_max), w = 0 for a miss.
@@ -214,7 +211,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
     }
     let r = trace_ray_setup(o, d);
     if FLAT_SCENE {
-        return flat_traverse(r, hit, any_hit, skip);
+        return baked_traverse(r, hit, any_hit, skip);
     }
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;

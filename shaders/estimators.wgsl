@@ -12,6 +12,7 @@ struct Shaded {
     next_dir: vec3<f32>,
     next_weight: vec3<f32>,   // f·cos/pdf of the continuation direction
     next_hit: Hit,
+    next_surface: Surface,  // surface_at(next_hit), when it hit something
 }
 
 /// The shading point as the techniques see it.
@@ -110,10 +111,13 @@ fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f
 struct Found {
     le: vec3<f32>,
     p_light: f32,
+    surface: Surface,   // the hit's shading point (reused as the path's next vertex)
 }
 
-fn found_emission(c: ShadingCtx, w: vec3<f32>, hit: Hit) -> Found {
-    var r = Found(vec3<f32>(0.0), 0.0);
+fn found_emission(c: ShadingCtx, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
+    var r: Found;
+    r.le = vec3<f32>(0.0);
+    r.p_light = 0.0;
     if (hit.prim == INVALID) {
         if (params.env_light != INVALID) {
             r.le = env_eval(w);
@@ -121,9 +125,10 @@ fn found_emission(c: ShadingCtx, w: vec3<f32>, hit: Hit) -> Found {
         }
         return r;
     }
-    let y = surface_at(hit, c.x.p, w);
+    let y = surface_at(hit, o, w);
+    r.surface = y;
     if (!y.front) { return r; }
-    r.le = material_emission(materials[y.material], y.uv);
+    r.le = material_emission(scene_material(y.material), y.uv);
     if (y.light != INVALID) {
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
         r.p_light = light_pmf(y.light) * light_pdf_li(y.light, c.x.p, w, y.p, y.ng);
@@ -132,8 +137,8 @@ fn found_emission(c: ShadingCtx, w: vec3<f32>, hit: Hit) -> Found {
 }
 
 /// shade(x, V, brdf, N): the direct-illumination estimate at one shading point, by the active strategy.
-/// When `want_next`, also returns a continuation direction for path tracing (the first direction
-/// sample, reused, or a fresh BSDF sample when the strategy traced none).
+/// When `want_next`, also returns the path's continuation: the first direction sample, its hit and the
+/// shading point there (traced for the continuation alone when the strategy counts no emission through it).
 fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     var out: Shaded;
     out.radiance = vec3<f32>(0.0);
@@ -169,8 +174,13 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
         out.radiance += light_estimate(c, j, f32(n_light), select(0.0, f32(n_dir), mis)) / f32(n_light);
     }
     // Direction samples: trace, and count what they find (weighted against light sampling under MIS).
+    // Sample 0 is also the path's continuation; a strategy that traces no direction here (light sampling,
+    // or one-sample MIS that chose the light) still traces it, for the continuation only (its emission is
+    // not counted: NEE already did). One trace site serves both — on lavapipe every call site's code runs
+    // whether or not a lane needs it, so a separate continuation trace would cost a third traversal.
     let dir_scale = select(1.0 / f32(max(n_dir, 1u)), 1.0 / (1.0 - f32(params.light_samples) / f32(params.light_samples + n_dir)), one_sample);
-    for (var j = 0u; j < min(dir_count, 64u); j += 1u) {
+    let n_traced = max(dir_count, select(0u, 1u, want_next));
+    for (var j = 0u; j < min(n_traced, 64u); j += 1u) {
         let ds = direction_sample(c, j);
         let wl = ds.xyz;
         let pdf = ds.w;
@@ -181,34 +191,17 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
         let o = spawn_origin(c.x, w);
         rays_traced += 1u;
         let hit = trace_closest(o, w, F32_MAX);
-        let found = found_emission(c, w, hit);
+        let found = found_emission(c, o, w, hit);
         var weight = 1.0;
         if (mis) { weight = mis_weight(f32(n_dir), pdf, f32(params.light_samples), found.p_light); }
-        out.radiance += weight * found.le * f * wl.z / pdf * dir_scale;
+        if (j < dir_count) { out.radiance += weight * found.le * f * wl.z / pdf * dir_scale; }
         if (j == 0u && want_next) {
             out.next_valid = true;
             out.next_origin = o;
             out.next_dir = w;
             out.next_weight = f * wl.z / pdf;
             out.next_hit = hit;
-        }
-    }
-    if (want_next && !out.next_valid) {
-        // The strategy traced no direction here (light sampling, or one-sample MIS chose the light):
-        // continue the path with a BSDF sample whose emission is not counted (NEE already did).
-        let base = dim_base(c.bounce, 0u);
-        let s = bsdf_sample(c.brdf, c.wo, sample_1d(c.id, base + DIM_BSDF_LOBE), sample_2d(c.id, base + DIM_BSDF_UV));
-        if (s.pdf > 0.0) {
-            let w = to_world(c.frame, s.wi);
-            if (dot(w, c.x.ng) > 0.0) {
-                let o = spawn_origin(c.x, w);
-                out.next_valid = true;
-                out.next_origin = o;
-                out.next_dir = w;
-                out.next_weight = s.f * s.wi.z / s.pdf;
-                rays_traced += 1u;
-                out.next_hit = trace_closest(o, w, F32_MAX);
-            }
+            out.next_surface = found.surface;
         }
     }
     return out;

@@ -19,6 +19,8 @@ fn radiance(px: vec2<u32>, id: SampleId) -> vec3<f32> {
     var o = params.cam_origin;
     rays_traced += 1u;
     var hit = trace_closest(o, d, F32_MAX);
+    // The shading point at `hit`: shade() returns the next one with its continuation ray.
+    var x = surface_at(hit, o, d);
     var l = vec3<f32>(0.0);
     var beta = vec3<f32>(1.0);
     let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);
@@ -28,8 +30,7 @@ fn radiance(px: vec2<u32>, id: SampleId) -> vec3<f32> {
             if (bounce == 0u && params.env_light != INVALID) { l += env_eval(d); }
             break;
         }
-        let x = surface_at(hit, o, d);
-        let m = materials[x.material];
+        let m = scene_material(x.material);
         if (bounce == 0u && x.front) { l += material_emission(m, x.uv); }
         var c: ShadingCtx;
         c.x = x;
@@ -53,6 +54,7 @@ fn radiance(px: vec2<u32>, id: SampleId) -> vec3<f32> {
         o = s.next_origin;
         d = s.next_dir;
         hit = s.next_hit;
+        x = s.next_surface;
     }
     return l;
 }

@@ -19,7 +19,7 @@ fn no_light_sample() -> LightSample {
 
 /// The primitive an area light is (a primitive reference), or INVALID for delta and environment lights.
 fn light_prim_ref(i: u32) -> u32 {
-    let l = lights[i];
+    let l = scene_light(i);
     switch l.kind {
         case LIGHT_TRIANGLE: { return make_prim(PRIM_TRIANGLE, l.prim); }
         case LIGHT_SPHERE: { return make_prim(PRIM_SPHERE, l.prim); }
@@ -30,7 +30,7 @@ fn light_prim_ref(i: u32) -> u32 {
 
 /// Probability of choosing light `i` under the active selection scheme.
 fn light_pmf(i: u32) -> f32 {
-    let l = lights[i];
+    let l = scene_light(i);
     return select(l.pmf_uniform, l.pmf_power, cfg_light_select() == LIGHT_SELECT_POWER);
 }
 
@@ -85,28 +85,29 @@ fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32
 
 /// Triangle light, uniform by area (barycentrics by Heitz's low-distortion map). Measure: area → solid angle.
 fn triangle_sample_li(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let v0 = tri_verts[3u * prim].xyz;
-    let v1 = tri_verts[3u * prim + 1u].xyz;
-    let v2 = tri_verts[3u * prim + 2u].xyz;
+    let tp = scene_tri_positions(prim);
+    let v0 = tp.v0;
+    let v1 = tp.v1;
+    let v2 = tp.v2;
     let c = cross(v1 - v0, v2 - v0);
     let area2 = length(c);
     if (!(area2 > 0.0)) { return no_light_sample(); }
     let b = square_to_uniform_triangle(u);
     let y = (1.0 - b.x - b.y) * v0 + b.x * v1 + b.y * v2;
-    let sh = tri_shading[prim];
+    let sh = scene_tri_shading(prim);
     let uv = (1.0 - b.x - b.y) * sh.uv0 + b.x * sh.uv1 + b.y * sh.uv2;
-    let emitted = material_emission(materials[sh.material], uv);
+    let emitted = material_emission(scene_material(sh.material), uv);
     return area_to_solid_angle(p, y, c / area2, 2.0 / area2, emitted);
 }
 
 /// Quad light, uniform by area. Measure: area → solid angle.
 fn quad_sample_li(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let q = quads[prim];
+    let q = scene_quad(prim);
     let c = cross(q.edge_u, q.edge_v);
     let area = length(c);
     if (!(area > 0.0)) { return no_light_sample(); }
     let y = q.corner + u.x * q.edge_u + u.y * q.edge_v;
-    let emitted = material_emission(materials[q.material], u);
+    let emitted = material_emission(scene_material(q.material), u);
     return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted);
 }
 
@@ -114,11 +115,11 @@ fn quad_sample_li(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
 /// as failed samples (pdf 0), so the pdf of the successful ones integrates to the visible fraction of the area.
 /// Measure: area → solid angle.
 fn sphere_sample_li_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let s = spheres[prim];
+    let s = scene_sphere(prim);
     let n = square_to_uniform_sphere(u);
     let y = s.center + s.radius * n;
     let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
-    let emitted = material_emission(materials[s.material], uv);
+    let emitted = material_emission(scene_material(s.material), uv);
     return area_to_solid_angle(p, y, n, 1.0 / (4.0 * PI * s.radius * s.radius), emitted);
 }
 
@@ -135,7 +136,7 @@ fn sphere_cone_one_minus_cos(s: Sphere, p: vec3<f32>) -> f32 {
 
 /// Sphere light, uniform in the subtended cone (solid angle). Measure: solid angle.
 fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let s = spheres[prim];
+    let s = scene_sphere(prim);
     let omc = sphere_cone_one_minus_cos(s, p);
     if (omc <= 0.0) { return sphere_sample_li_area(prim, p, u); }
     let to_c = s.center - p;
@@ -151,7 +152,7 @@ fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let y = p + t * wi;
     let n = normalize(y - s.center);
     let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
-    let emitted = material_emission(materials[s.material], uv);
+    let emitted = material_emission(scene_material(s.material), uv);
     return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), false);
 }
 
@@ -190,9 +191,10 @@ fn triangle_light_omega(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32
 
 /// Triangle light, uniform in solid angle (spherical triangle), else by area. Measure: solid angle.
 fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let v0 = tri_verts[3u * prim].xyz;
-    let v1 = tri_verts[3u * prim + 1u].xyz;
-    let v2 = tri_verts[3u * prim + 2u].xyz;
+    let tp = scene_tri_positions(prim);
+    let v0 = tp.v0;
+    let v1 = tp.v1;
+    let v2 = tp.v2;
     let omega = triangle_light_omega(v0, v1, v2, p);
     if (omega == 0.0) { return no_light_sample(); }
     if (omega < 0.0) { return triangle_sample_li(prim, p, u); }
@@ -205,9 +207,9 @@ fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> Ligh
     let inv_nn = 1.0 / dot(n, n);
     let b1 = clamp(dot(cross(y - v0, v2 - v0), n) * inv_nn, 0.0, 1.0);
     let b2 = clamp(dot(cross(v1 - v0, y - v0), n) * inv_nn, 0.0, 1.0);
-    let sh = tri_shading[prim];
+    let sh = scene_tri_shading(prim);
     let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
-    let emitted = material_emission(materials[sh.material], uv);
+    let emitted = material_emission(scene_material(sh.material), uv);
     return LightSample(wi, t, emitted, 1.0 / omega, false);
 }
 
@@ -245,7 +247,7 @@ fn quad_light_frame(q: Quad, p: vec3<f32>) -> QuadLightFrame {
 /// Quad light, uniform in solid angle (spherical rectangle) when it is a rectangle, else by area.
 /// Measure: solid angle.
 fn quad_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let q = quads[prim];
+    let q = scene_quad(prim);
     let f = quad_light_frame(q, p);
     if (f.rect.omega == 0.0) { return no_light_sample(); }
     if (f.rect.omega < 0.0) { return quad_sample_li(prim, p, u); }
@@ -253,7 +255,7 @@ fn quad_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSam
     let v = xy.x * f.x + xy.y * f.y - f.rect.h * f.z;
     let dist = length(v);
     let st = vec2<f32>((xy.x - f.rect.x0) / f.lu, (xy.y - f.rect.y0) / f.lv);
-    let emitted = material_emission(materials[q.material], st);
+    let emitted = material_emission(scene_material(q.material), st);
     return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, false);
 }
 
@@ -348,7 +350,7 @@ fn env_sample_li(u: vec3<f32>) -> LightSample {
 
 /// Samples a point or direction on light `i` as seen from p (without the selection probability).
 fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    let l = lights[i];
+    let l = scene_light(i);
     let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
     switch (l.kind) {
         case LIGHT_TRIANGLE: {
@@ -380,16 +382,17 @@ fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
 /// decisions are the samplers' own (`triangle_light_omega`, `quad_light_frame`, `sphere_cone_one_minus_cos`);
 /// a triangle or quad seen from behind has pdf 0 (one-sided emitters).
 fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
-    let l = lights[i];
+    let l = scene_light(i);
     if (l.kind == LIGHT_ENVIRONMENT) { return env_pdf(wi); }
     if (l.kind > LIGHT_QUAD) { return 0.0; }
     let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
     let v = y - p;
     let d2 = dot(v, v);
     if (HAS_TRIANGLE_LIGHTS && l.kind == LIGHT_TRIANGLE) {
-        let v0 = tri_verts[3u * l.prim].xyz;
-        let v1 = tri_verts[3u * l.prim + 1u].xyz;
-        let v2 = tri_verts[3u * l.prim + 2u].xyz;
+        let tp = scene_tri_positions(l.prim);
+        let v0 = tp.v0;
+        let v1 = tp.v1;
+        let v2 = tp.v2;
         let n = cross(v1 - v0, v2 - v0);
         if (solid_angle) {
             let omega = triangle_light_omega(v0, v1, v2, p);
@@ -402,7 +405,7 @@ fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32
         return 2.0 * d2 / c;
     }
     if (HAS_QUAD_LIGHTS && l.kind == LIGHT_QUAD) {
-        let q = quads[l.prim];
+        let q = scene_quad(l.prim);
         let n = cross(q.edge_u, q.edge_v);
         if (solid_angle) {
             let f = quad_light_frame(q, p);
@@ -415,7 +418,7 @@ fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32
     }
     if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE) {
         if (solid_angle) {
-            let omc = sphere_cone_one_minus_cos(spheres[l.prim], p);
+            let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
             if (omc > 0.0) { return square_to_uniform_cone_pdf(omc); }
         }
         let cos_l = abs(dot(wi, n_y));

@@ -20,20 +20,21 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
     var ng: vec3<f32>;
     var ns: vec3<f32>;
     if (HAS_TRIANGLES && kind == PRIM_TRIANGLE) {
-        let v0 = tri_verts[3u * i].xyz;
-        let v1 = tri_verts[3u * i + 1u].xyz;
-        let v2 = tri_verts[3u * i + 2u].xyz;
+        let tp = scene_tri_positions(i);
+        let v0 = tp.v0;
+        let v1 = tp.v1;
+        let v2 = tp.v2;
         let b0 = 1.0 - hit.b1 - hit.b2;
         // Barycentric interpolation keeps the point on the triangle's plane (o + t·d drifts off it).
         s.p = b0 * v0 + hit.b1 * v1 + hit.b2 * v2;
         ng = normalize(cross(v1 - v0, v2 - v0));
-        let sh = tri_shading[i];
+        let sh = scene_tri_shading(i);
         ns = b0 * sh.n0 + hit.b1 * sh.n1 + hit.b2 * sh.n2;
         s.uv = b0 * sh.uv0 + hit.b1 * sh.uv1 + hit.b2 * sh.uv2;
         s.material = sh.material;
         s.light = sh.light;
     } else if (HAS_SPHERES && kind == PRIM_SPHERE) {
-        let sp = spheres[i];
+        let sp = scene_sphere(i);
         let q = o + hit.t * d;
         ng = normalize(q - sp.center);
         s.p = sp.center + sp.radius * ng;   // re-projected onto the sphere
@@ -42,7 +43,7 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
         s.material = sp.material;
         s.light = sp.light;
     } else if (HAS_QUADS) {
-        let q = quads[i];
+        let q = scene_quad(i);
         s.p = q.corner + hit.b1 * q.edge_u + hit.b2 * q.edge_v;
         ng = normalize(cross(q.edge_u, q.edge_v));
         ns = ng;

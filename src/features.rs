@@ -49,10 +49,19 @@ pub struct Features {
     /// of traversing a BVH (no stack, no divergent traversal; on lavapipe a loop over a few primitives of one
     /// kind beats a tree walk). None = BVH.
     pub flat: Option<(u32, u32, u32)>,
+    /// For flat scenes, a hash of the scene data baked into its pipelines' source (src/baked.rs), so that a
+    /// pipeline cache never hands one scene's baked pipeline to another; 0 otherwise.
+    pub baked: u64,
 }
 
 /// Largest primitive count rendered without a BVH (`Features::flat`).
 pub const FLAT_MAX_PRIMS: usize = 32;
+
+/// (triangles, spheres, quads) of a scene small enough to test every primitive without a BVH.
+pub fn flat_counts(data: &SceneData) -> Option<(u32, u32, u32)> {
+    let n = (data.tri_shading.len(), data.spheres.len(), data.quads.len());
+    (n.0 + n.1 + n.2 <= FLAT_MAX_PRIMS).then_some((n.0 as u32, n.1 as u32, n.2 as u32))
+}
 
 impl Features {
     /// Everything compiled in.
@@ -71,6 +80,7 @@ impl Features {
             diffuse: true,
             many_lights: true,
             flat: None,
+            baked: 0,
         }
     }
 
@@ -95,10 +105,13 @@ impl Features {
             specular: data.materials.iter().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: data.materials.iter().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             many_lights: data.lights.len() > 1,
-            flat: {
-                let n = (data.tri_shading.len(), data.spheres.len(), data.quads.len());
-                (n.0 + n.1 + n.2 <= FLAT_MAX_PRIMS).then_some((n.0 as u32, n.1 as u32, n.2 as u32))
-            },
+            flat: flat_counts(data),
+            baked: crate::baked::scene_data_source(data).map_or(0, |src| {
+                use std::hash::{Hash, Hasher};
+                let mut h = std::collections::hash_map::DefaultHasher::new();
+                src.hash(&mut h);
+                h.finish() | 1
+            }),
         }
     }
 

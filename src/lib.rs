@@ -3,6 +3,7 @@
 //! Data flows one way (see `../shared/DESIGN.md`): scene file → [`scene::Scene`] → [`gpu_scene::GpuScene`]
 //! (+ [`bvh`], [`lights`]) → [`render::Renderer`] (progressive accumulation) → [`film`] (PNG / EXR).
 
+pub mod baked;
 pub mod bench;
 pub mod bvh;
 pub mod chi2;

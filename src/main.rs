@@ -74,6 +74,9 @@ struct SettingsArgs {
     /// Maximum path length in bounces (path mode).
     #[arg(long, default_value_t = 8)]
     max_depth: u32,
+    /// Russian roulette from this many bounces on (path mode; at least --max-depth turns it off).
+    #[arg(long, default_value_t = mislab::render::RR_DEPTH)]
+    rr_depth: u32,
     /// Estimator: uniform, cosine, bsdf, light or mis.
     #[arg(long, value_enum, default_value_t = Strategy::Mis)]
     strategy: Strategy,
@@ -126,6 +129,7 @@ impl SettingsArgs {
             bsdf_samples: self.bsdf_samples,
             sampler: self.sampler,
             max_depth: self.max_depth,
+            rr_depth: self.rr_depth,
             seed: self.seed,
             exposure: self.exposure,
         }

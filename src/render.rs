@@ -20,6 +20,8 @@ pub const RENDER_FILES: &[&str] = &[
     "samplers.wgsl",
     "warps.wgsl",
     "bvh.wgsl",
+    "baked_geometry.wgsl",
+    "scene_data.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
     "lights.wgsl",
@@ -28,12 +30,23 @@ pub const RENDER_FILES: &[&str] = &[
     "integrator.wgsl",
 ];
 
-/// Depth after which Russian roulette starts (the issue: "after depth 3").
+/// Default bounce count from which Russian roulette decides whether a path continues (issue 3: "after depth 3").
 pub const RR_DEPTH: u32 = 3;
 
-/// The composed render module.
+/// The render module that reads the scene from its buffers (the generic pipeline, shared between scenes).
 pub fn render_source() -> String {
     shaders::compose(RENDER_FILES, "")
+}
+
+/// The render module for one scene: with its data baked in when it is small enough (`Features::flat`), else
+/// `render_source()`.
+pub fn render_source_for(data: &crate::gpu_scene::SceneData) -> String {
+    match crate::baked::scene_data_source(data) {
+        Some((data, geometry)) => {
+            shaders::compose_replacing(RENDER_FILES, &[("scene_data.wgsl", &data), ("baked_geometry.wgsl", &geometry)])
+        }
+        None => render_source(),
+    }
 }
 
 /// A progressive renderer of one scene with one set of settings (change either → `reset`).
@@ -75,6 +88,9 @@ pub struct Renderer {
     /// The scene's render origin (`SceneData::origin`): the camera is placed relative to it.
     origin: glam::Vec3,
     offset_scale: f32,
+    /// This scene's render module (`render_source_for`) and the shared one (`render_source`).
+    source: String,
+    shared_source: String,
 }
 
 impl Renderer {
@@ -214,6 +230,8 @@ impl Renderer {
             num_lights: d.lights.len() as u32,
             origin: d.origin,
             offset_scale: d.offset_scale,
+            source: render_source_for(d),
+            shared_source: render_source(),
         };
         r.reset();
         Ok(r)
@@ -244,6 +262,25 @@ impl Renderer {
         }
     }
 
+    /// The module a pipeline with `key` is built from: this scene's baked source for its baked pipelines, else the
+    /// shared one (generic pipelines are shared between scenes; see `insert_pipeline`).
+    pub fn source_for(&self, key: &PipelineKey) -> &str {
+        if key.features.baked != 0 {
+            &self.source
+        } else {
+            &self.shared_source
+        }
+    }
+
+    /// Replaces the source of baked pipelines (a renderer that compiles other scenes' pipelines ahead of use,
+    /// like the viewer's warm-up renderer); forgets the baked pipelines built from the old one.
+    pub fn set_baked_source(&mut self, source: &str) {
+        if self.source != source {
+            self.source = source.to_string();
+            self.pipelines.retain(|k, _| k.features.baked == 0);
+        }
+    }
+
     /// Builds (or finds in the cache) the pipeline for the current settings.
     pub fn prepare(&mut self) -> Result<(), String> {
         let key = self.key();
@@ -251,7 +288,7 @@ impl Renderer {
             let p = shaders::compute_pipeline(
                 &self.device,
                 "render",
-                &render_source(),
+                self.source_for(&key),
                 "render_main",
                 &key.constants(),
                 Some(&self.pipeline_layout),
@@ -324,7 +361,7 @@ impl Renderer {
             mis_kind: s.mis.tag(),
             sampler: s.sampler.tag(),
             num_lights: self.num_lights,
-            rr_depth: RR_DEPTH,
+            rr_depth: s.rr_depth,
             env_light: self.env_light,
             cam_origin: (self.camera.position - self.origin).into(),
             tan_half_fov: (0.5 * self.camera.vfov).tan(),

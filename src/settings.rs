@@ -164,6 +164,8 @@ pub struct Settings {
     pub sampler: SamplerKind,
     /// Maximum number of bounces in path mode (1 = direct lighting only).
     pub max_depth: u32,
+    /// Russian roulette decides whether paths continue from this bounce count on (path mode; ≥ max_depth: never).
+    pub rr_depth: u32,
     /// Seed of every random number.
     pub seed: u32,
     /// Exposure in stops for PNG output and display.
@@ -187,6 +189,7 @@ impl Default for Settings {
             bsdf_samples: 1,
             sampler: SamplerKind::Independent,
             max_depth: 8,
+            rr_depth: crate::render::RR_DEPTH,
             seed: 0,
             exposure: 0.0,
         }
@@ -204,6 +207,9 @@ impl Settings {
         }
         if self.light_samples > 64 || self.bsdf_samples > 64 || self.light_samples + self.bsdf_samples == 0 {
             return Err("--light-samples and --bsdf-samples must be in 0..=64 and not both 0".into());
+        }
+        if self.rr_depth == 0 {
+            return Err("--rr-depth must be at least 1".into());
         }
         if self.max_depth == 0 || self.max_depth > 256 {
             return Err(format!("--max-depth {} is out of range (1..=256)", self.max_depth));

@@ -6,6 +6,8 @@ pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../shaders/common.wgsl")),
     ("geometry_bindings.wgsl", include_str!("../shaders/geometry_bindings.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
+    ("baked_geometry.wgsl", include_str!("../shaders/baked_geometry.wgsl")),
+    ("scene_data.wgsl", include_str!("../shaders/scene_data.wgsl")),
     ("shading_bindings.wgsl", include_str!("../shaders/shading_bindings.wgsl")),
     ("specialize.wgsl", include_str!("../shaders/specialize.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
@@ -39,6 +41,17 @@ pub fn compose(files: &[&str], extra: &str) -> String {
         out += "\n";
     }
     out += extra;
+    out
+}
+
+/// `compose` with some files' text replaced (a scene's generated `scene_data.wgsl` and `baked_geometry.wgsl`).
+pub fn compose_replacing(files: &[&str], replacements: &[(&str, &str)]) -> String {
+    let mut out = String::new();
+    for f in files {
+        out += &format!("// ---- {f} ----\n");
+        out += replacements.iter().find(|(n, _)| n == f).map_or_else(|| file(f), |(_, text)| text);
+        out += "\n";
+    }
     out
 }
 

@@ -87,7 +87,7 @@ fn probe_spawn(s: ProbeSpawn) -> ProbeSpawnOut {
 ";
 
 fn probe_source() -> String {
-    mislab::shaders::compose(&["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl"], PROBE_WGSL)
+    mislab::shaders::compose(&["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "baked_geometry.wgsl"], PROBE_WGSL)
 }
 
 struct Geometry {

@@ -315,6 +315,8 @@ fn engine_main(
 /// A pipeline the worker should build.
 struct CompileJob {
     key: PipelineKey,
+    /// The module to build it from (`Renderer::source_for`: baked pipelines belong to one scene).
+    source: Arc<String>,
     settings: Settings,
     /// Lower first.
     priority: u32,
@@ -362,7 +364,6 @@ fn compile_worker(
     });
     let mut warm = warm;
     let mut queue: Vec<CompileJob> = Vec::new();
-    let source = crate::render::render_source();
     loop {
         if queue.is_empty() {
             match jobs.recv() {
@@ -392,13 +393,14 @@ fn compile_worker(
             r.features = job.key.features;
             r.settings = Settings { width: 8, height: 8, ..job.settings.clone() };
             r.specialize = job.key.fixed.is_some();
+            r.set_baked_source(&job.source);
             if r.key() == job.key {
                 let _ = r.prepare().and_then(|_| r.warm_up(c).map_err(|e| e.to_string()));
             }
         }
         let constants = job.key.constants();
         let result =
-            crate::shaders::compute_pipeline(&device, "render", &source, "render_main", &constants, Some(&layout));
+            crate::shaders::compute_pipeline(&device, "render", &job.source, "render_main", &constants, Some(&layout));
         if done.send((job.key, result, t.elapsed().as_secs_f64())).is_err() {
             return;
         }
@@ -748,7 +750,8 @@ impl Engine {
         }
         self.job_settings.insert(key, settings.clone());
         self.seq += 1;
-        let _ = self.jobs.send(CompileJob { key, settings: settings.clone(), priority, seq: self.seq });
+        let source = Arc::new(self.sides[0].renderer.source_for(&key).to_string());
+        let _ = self.jobs.send(CompileJob { key, source, settings: settings.clone(), priority, seq: self.seq });
     }
 
     /// The keys the active sides need now, their every-strategy neighbours, and the generic one.
