@@ -97,21 +97,24 @@ fn sobol_block_dim(dim: u32) -> u32 {
     return select((comp + 3u) & 3u, comp, dim < 4u);
 }
 
+/// Sobol dimension 1 before its final bit reversal: the index times Pascal's triangle mod 2.
+fn sobol_pascal(index: u32) -> u32 {
+    var x = index;
+    x ^= (x & 0xaaaaaaaau) >> 1u;
+    x ^= (x & 0xccccccccu) >> 2u;
+    x ^= (x & 0xf0f0f0f0u) >> 4u;
+    x ^= (x & 0xff00ff00u) >> 8u;
+    x ^= (x & 0xffff0000u) >> 16u;
+    return x;
+}
+
 /// Sobol coordinate `sd` of point `index` as 0.32 fixed point. Dimension 0 is the bit reversal; dimension 1
 /// (Pascal's triangle mod 2) is a superset-sum transform; dimensions 2–3 XOR four byte-table entries from
 /// sampler_data. No loops: lavapipe counts every loop iteration of an invocation against one budget of 65535
 /// and silently stops looping when it runs out.
 fn sobol_bits(index: u32, sd: u32) -> u32 {
     if (sd == 0u) { return reverseBits(index); }
-    if (sd == 1u) {
-        var x = index;
-        x ^= (x & 0xaaaaaaaau) >> 1u;
-        x ^= (x & 0xccccccccu) >> 2u;
-        x ^= (x & 0xf0f0f0f0u) >> 4u;
-        x ^= (x & 0xff00ff00u) >> 8u;
-        x ^= (x & 0xffff0000u) >> 16u;
-        return reverseBits(x);
-    }
+    if (sd == 1u) { return reverseBits(sobol_pascal(index)); }
     let base = SOBOL_OFFSET + (sd - 2u) * 1024u;
     return sampler_data[base + (index & 255u)] ^ sampler_data[base + 256u + ((index >> 8u) & 255u)]
          ^ sampler_data[base + 512u + ((index >> 16u) & 255u)] ^ sampler_data[base + 768u + (index >> 24u)];
@@ -124,7 +127,22 @@ fn sobol_owen_bits(index: u32, dim: u32, block_seed: u32) -> u32 {
     let sd = sobol_block_dim(dim);
     let i = nested_uniform_scramble(index, block_seed);
     let x = sobol_bits(i, sd);
-    return nested_uniform_scramble(x, pcg_hash(block_seed ^ (sd * 0x9e3779b9u + 0x7f4a7c15u)));
+    return nested_uniform_scramble(x, sobol_dim_seed(block_seed, sd));
+}
+
+fn sobol_dim_seed(block_seed: u32, sd: u32) -> u32 {
+    return pcg_hash(block_seed ^ (sd * 0x9e3779b9u + 0x7f4a7c15u));
+}
+
+/// `sobol_owen_bits` for both dimensions of a block's 2D pair (Sobol dimensions 0 and 1), bit for bit, at less
+/// than half the cost: one index shuffle for both, and since those dimensions are bit reversals (of the index
+/// and of its Pascal transform), Owen-scrambling them is reverseBits(LK(y)) — one reversal instead of three.
+fn sobol_owen_pair(index: u32, block_seed: u32) -> vec2<u32> {
+    let i = nested_uniform_scramble(index, block_seed);
+    return vec2<u32>(
+        reverseBits(laine_karras_permutation(i, sobol_dim_seed(block_seed, 0u))),
+        reverseBits(laine_karras_permutation(sobol_pascal(i), sobol_dim_seed(block_seed, 1u))),
+    );
 }
 
 // ---- Random permutations of 0 … n − 1 (stratified, Hammersley).
@@ -327,8 +345,14 @@ fn sample_1d(id: SampleId, dim: u32) -> f32 {
     return sample_independent(id, dim);
 }
 
-/// Two consecutive dimensions of the active sequence (2D strata for the stratified sampler).
+/// Two consecutive dimensions of the active sequence (2D strata for the stratified sampler). `dim` must start a
+/// block's 2D pair (dimension 0, or component 1 of a later block): the Sobol samplers read the pair together.
 fn sample_2d(id: SampleId, dim: u32) -> vec2<f32> {
-    if (cfg_sampler() == SAMPLER_STRATIFIED) { return sample_stratified_2d(id, dim); }
+    let k = cfg_sampler();
+    if (k == SAMPLER_STRATIFIED) { return sample_stratified_2d(id, dim); }
+    if (k == SAMPLER_SOBOL) {
+        let xy = sobol_owen_pair(id.index, hash4(id.pixel, dim >> 2u, params.seed, SALT_SOBOL));
+        return vec2<f32>(bits_to_unit(xy.x), bits_to_unit(xy.y));
+    }
     return vec2<f32>(sample_1d(id, dim), sample_1d(id, dim + 1u));
 }
