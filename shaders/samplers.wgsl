@@ -97,6 +97,48 @@ fn sobol_block_dim(dim: u32) -> u32 {
     return select((comp + 3u) & 3u, comp, dim < 4u);
 }
 
+/// Sobol dimensions 2 and 3 (sd = 2, 3) without tables: the XOR of the generator-matrix columns (src/samplers.rs
+/// `sobol_matrix`) of the index's set bits, unrolled. No loads (a storage-buffer read is a loop over the lanes on
+/// lavapipe: the four byte-table reads this replaces cost more than these 32 masked XORs) and no loop (every loop
+/// iteration counts against lavapipe's per-invocation budget).
+fn sobol_matrix_bits(index: u32, sd: u32) -> u32 {
+    let two = sd == 2u;
+    var x = 0u;
+    x ^= (0u - ((index >> 0u) & 1u)) & select(0x80000000u, 0x80000000u, two);
+    x ^= (0u - ((index >> 1u) & 1u)) & select(0xc0000000u, 0xc0000000u, two);
+    x ^= (0u - ((index >> 2u) & 1u)) & select(0x20000000u, 0x60000000u, two);
+    x ^= (0u - ((index >> 3u) & 1u)) & select(0x50000000u, 0x90000000u, two);
+    x ^= (0u - ((index >> 4u) & 1u)) & select(0xf8000000u, 0xe8000000u, two);
+    x ^= (0u - ((index >> 5u) & 1u)) & select(0x74000000u, 0x5c000000u, two);
+    x ^= (0u - ((index >> 6u) & 1u)) & select(0xa2000000u, 0x8e000000u, two);
+    x ^= (0u - ((index >> 7u) & 1u)) & select(0x93000000u, 0xc5000000u, two);
+    x ^= (0u - ((index >> 8u) & 1u)) & select(0xd8800000u, 0x68800000u, two);
+    x ^= (0u - ((index >> 9u) & 1u)) & select(0x25400000u, 0x9cc00000u, two);
+    x ^= (0u - ((index >> 10u) & 1u)) & select(0x59e00000u, 0xee600000u, two);
+    x ^= (0u - ((index >> 11u) & 1u)) & select(0xe6d00000u, 0x55900000u, two);
+    x ^= (0u - ((index >> 12u) & 1u)) & select(0x78080000u, 0x80680000u, two);
+    x ^= (0u - ((index >> 13u) & 1u)) & select(0xb40c0000u, 0xc09c0000u, two);
+    x ^= (0u - ((index >> 14u) & 1u)) & select(0x82020000u, 0x60ee0000u, two);
+    x ^= (0u - ((index >> 15u) & 1u)) & select(0xc3050000u, 0x90550000u, two);
+    x ^= (0u - ((index >> 16u) & 1u)) & select(0x208f8000u, 0xe8808000u, two);
+    x ^= (0u - ((index >> 17u) & 1u)) & select(0x51474000u, 0x5cc0c000u, two);
+    x ^= (0u - ((index >> 18u) & 1u)) & select(0xfbea2000u, 0x8e606000u, two);
+    x ^= (0u - ((index >> 19u) & 1u)) & select(0x75d93000u, 0xc5909000u, two);
+    x ^= (0u - ((index >> 20u) & 1u)) & select(0xa0858800u, 0x6868e800u, two);
+    x ^= (0u - ((index >> 21u) & 1u)) & select(0x914e5400u, 0x9c9c5c00u, two);
+    x ^= (0u - ((index >> 22u) & 1u)) & select(0xdbe79e00u, 0xeeee8e00u, two);
+    x ^= (0u - ((index >> 23u) & 1u)) & select(0x25db6d00u, 0x5555c500u, two);
+    x ^= (0u - ((index >> 24u) & 1u)) & select(0x58800080u, 0x8000e880u, two);
+    x ^= (0u - ((index >> 25u) & 1u)) & select(0xe54000c0u, 0xc0005cc0u, two);
+    x ^= (0u - ((index >> 26u) & 1u)) & select(0x79e00020u, 0x60008e60u, two);
+    x ^= (0u - ((index >> 27u) & 1u)) & select(0xb6d00050u, 0x9000c590u, two);
+    x ^= (0u - ((index >> 28u) & 1u)) & select(0x800800f8u, 0xe8006868u, two);
+    x ^= (0u - ((index >> 29u) & 1u)) & select(0xc00c0074u, 0x5c009c9cu, two);
+    x ^= (0u - ((index >> 30u) & 1u)) & select(0x200200a2u, 0x8e00eeeeu, two);
+    x ^= (0u - ((index >> 31u) & 1u)) & select(0x50050093u, 0xc5005555u, two);
+    return x;
+}
+
 /// Sobol dimension 1 before its final bit reversal: the index times Pascal's triangle mod 2.
 fn sobol_pascal(index: u32) -> u32 {
     var x = index;
@@ -109,15 +151,13 @@ fn sobol_pascal(index: u32) -> u32 {
 }
 
 /// Sobol coordinate `sd` of point `index` as 0.32 fixed point. Dimension 0 is the bit reversal; dimension 1
-/// (Pascal's triangle mod 2) is a superset-sum transform; dimensions 2–3 XOR four byte-table entries from
-/// sampler_data. No loops: lavapipe counts every loop iteration of an invocation against one budget of 65535
+/// (Pascal's triangle mod 2) is a superset-sum transform; dimensions 2–3 are `sobol_matrix_bits` (the byte tables
+/// in sampler_data serve the CPU twin). No loops: lavapipe counts every loop iteration of an invocation against one budget of 65535
 /// and silently stops looping when it runs out.
 fn sobol_bits(index: u32, sd: u32) -> u32 {
     if (sd == 0u) { return reverseBits(index); }
     if (sd == 1u) { return reverseBits(sobol_pascal(index)); }
-    let base = SOBOL_OFFSET + (sd - 2u) * 1024u;
-    return sampler_data[base + (index & 255u)] ^ sampler_data[base + 256u + ((index >> 8u) & 255u)]
-         ^ sampler_data[base + 512u + ((index >> 16u) & 255u)] ^ sampler_data[base + 768u + (index >> 24u)];
+    return sobol_matrix_bits(index, sd);
 }
 
 /// Padded, shuffled, Owen-scrambled Sobol (Burley 2020 §4): the index is shuffled by a nested uniform scramble
