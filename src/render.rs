@@ -436,12 +436,14 @@ impl Renderer {
     }
 
     /// Most samples per pixel one dispatch may take without exhausting a driver's per-invocation loop
-    /// budget (path tracing runs far more traversal steps per sample than direct lighting).
+    /// budget (path tracing through a BVH runs far more traversal steps per sample than direct lighting).
     pub fn max_dispatch_spp(&self) -> u32 {
         if let Some(n) = self.dispatch_spp {
             return n;
         }
-        if self.settings.mode == Mode::Path {
+        // A baked scene's traversal has no loops, so a path sample spends a few loop iterations per vertex
+        // (render_main's vertex loop, shade's sample loops); a BVH walk spends one per node visited.
+        if self.settings.mode == Mode::Path && self.features.flat.is_none() {
             4
         } else {
             16
