@@ -245,8 +245,5 @@ override HAS_SPECULAR: bool = true;
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.
 override MANY_LIGHTS: bool = true;
-/// Scenes of a few primitives: test them one kind at a time instead of walking the BVH (features.rs).
+/// Scenes of a few primitives, baked into the shader: traversal is the generated `baked_traverse` (src/baked.rs).
 override FLAT_SCENE: bool = false;
-override FLAT_TRIANGLES: u32 = 0u;
-override FLAT_SPHERES: u32 = 0u;
-override FLAT_QUADS: u32 = 0u;

@@ -45,9 +45,9 @@ pub struct Features {
     pub diffuse: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
-    /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads) tested one by one instead
-    /// of traversing a BVH (no stack, no divergent traversal; on lavapipe a loop over a few primitives of one
-    /// kind beats a tree walk). None = BVH.
+    /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
+    /// (src/baked.rs): every primitive tested, unrolled, with its data as literals, instead of a BVH walk (no
+    /// stack, no divergent traversal, no buffer reads). None = BVH.
     pub flat: Option<(u32, u32, u32)>,
     /// For flat scenes, a hash of the scene data baked into its pipelines' source (src/baked.rs), so that a
     /// pipeline cache never hands one scene's baked pipeline to another; 0 otherwise.
@@ -132,9 +132,6 @@ impl Features {
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("MANY_LIGHTS", b(self.many_lights)),
             ("FLAT_SCENE", b(self.flat.is_some())),
-            ("FLAT_TRIANGLES", self.flat.map_or(0.0, |f| f.0 as f64)),
-            ("FLAT_SPHERES", self.flat.map_or(0.0, |f| f.1 as f64)),
-            ("FLAT_QUADS", self.flat.map_or(0.0, |f| f.2 as f64)),
         ]
     }
 
@@ -158,7 +155,7 @@ impl Features {
         on("diffuse lobe", self.diffuse);
         on("light selection", self.many_lights);
         if let Some((t, s, q)) = self.flat {
-            v.push(format!("flat primitive loops ({t} triangles, {s} spheres, {q} quads; no BVH)"));
+            v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));
         }
         v.push(format!("environment: {:?}", self.env).to_lowercase());
         v.join(", ")
