@@ -114,7 +114,8 @@ struct Found {
     surface: Surface,   // the hit's shading point (reused as the path's next vertex)
 }
 
-fn found_emission(c: ShadingCtx, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
+/// What the ray o + t·w leaving the shading point at `from_p` found at `hit`.
+fn found_emission(from_p: vec3<f32>, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
     var r: Found;
     r.le = vec3<f32>(0.0);
     r.p_light = 0.0;
@@ -131,9 +132,67 @@ fn found_emission(c: ShadingCtx, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found 
     r.le = material_emission(scene_material(y.material), y.uv);
     if (y.light != INVALID) {
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
-        r.p_light = light_pmf(y.light) * light_pdf_li(y.light, c.x.p, w, y.p, y.ng);
+        r.p_light = light_pmf(y.light) * light_pdf_li(y.light, from_p, w, y.p, y.ng);
     }
     return r;
+}
+
+/// How the active strategy splits one shading point's work between the two technique families.
+struct Plan {
+    light_runs: u32,     // light-technique samples taken here
+    light_n: f32,        // their count as MIS sees it
+    light_partner: f32,  // direction samples weighed against them (0 = no MIS)
+    light_div: f32,      // each light sample's estimate is divided by this
+    n_dir: u32,          // direction-technique samples per shading point
+    dir_count: u32,      // direction samples whose emission counts (0: light sampling, or one-sample MIS chose it)
+    dir_scale: f32,      // factor on each counted direction sample
+}
+
+fn strategy_plan(c: ShadingCtx) -> Plan {
+    var p: Plan;
+    p.light_runs = 0u;
+    p.n_dir = 0u;
+    switch (cfg_strategy()) {
+        case STRATEGY_LIGHT: { p.light_runs = params.light_samples; }
+        case STRATEGY_MIS: {
+            p.light_runs = params.light_samples;
+            p.n_dir = params.bsdf_samples;
+        }
+        default: { p.n_dir = params.bsdf_samples; }
+    }
+    let mis = cfg_strategy() == STRATEGY_MIS;
+    p.light_n = f32(params.light_samples);
+    p.light_partner = select(0.0, f32(p.n_dir), mis);
+    p.light_div = f32(p.light_runs);
+    p.dir_count = p.n_dir;
+    p.dir_scale = 1.0 / f32(max(p.n_dir, 1u));
+    if (mis && cfg_mis_kind() == MIS_ONE) {
+        // One-sample MIS: pick the light technique with probability c_l = n_l / (n_l + n_d); the
+        // estimate is w_i·f/(c_i·p_i) for the chosen technique i (Veach §9.2.4).
+        let c_l = f32(params.light_samples) / f32(params.light_samples + p.n_dir);
+        let choose_light = sample_1d(c.id, dim_base(c.bounce, 0u) + DIM_MIS_CHOICE) < c_l;
+        p.light_runs = select(0u, 1u, choose_light);
+        p.light_div = c_l;
+        p.dir_count = select(1u, 0u, choose_light);
+        p.dir_scale = 1.0 / (1.0 - c_l);
+    }
+    return p;
+}
+
+/// The light-technique half of shade(): `plan.light_runs` samples of the lights, each weighed against the
+/// direction technique under MIS.
+fn shade_lights(c: ShadingCtx, plan: Plan) -> vec3<f32> {
+    var l = vec3<f32>(0.0);
+    for (var j = 0u; j < min(plan.light_runs, 64u); j += 1u) {
+        l += light_estimate(c, j, plan.light_n, plan.light_partner) / plan.light_div;
+    }
+    return l;
+}
+
+/// The weight of emission found by a direction sample of pdf `dir_pdf`, whose light-technique pdf is `p_light`.
+fn direction_emission_weight(plan_n_dir: u32, dir_pdf: f32, p_light: f32) -> f32 {
+    if (cfg_strategy() != STRATEGY_MIS) { return 1.0; }
+    return mis_weight(f32(plan_n_dir), dir_pdf, f32(params.light_samples), p_light);
 }
 
 /// shade(x, V, brdf, N): the direct-illumination estimate at one shading point, by the active strategy.
@@ -141,45 +200,15 @@ fn found_emission(c: ShadingCtx, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found 
 /// shading point there (traced for the continuation alone when the strategy counts no emission through it).
 fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     var out: Shaded;
-    out.radiance = vec3<f32>(0.0);
     out.next_valid = false;
-    var n_light = 0u;
-    var n_dir = 0u;
-    var one_sample = false;
-    switch (cfg_strategy()) {
-        case STRATEGY_LIGHT: { n_light = params.light_samples; }
-        case STRATEGY_MIS: {
-            n_light = params.light_samples;
-            n_dir = params.bsdf_samples;
-            one_sample = cfg_mis_kind() == MIS_ONE;
-        }
-        default: { n_dir = params.bsdf_samples; }
-    }
-    let mis = cfg_strategy() == STRATEGY_MIS;
-    var dir_count = n_dir;
-    if (one_sample) {
-        // One-sample MIS: pick the light technique with probability c_l = n_l / (n_l + n_d); the
-        // estimate is w_i·f/(c_i·p_i) for the chosen technique i (Veach §9.2.4).
-        let c_l = f32(n_light) / f32(n_light + n_dir);
-        let choose_light = sample_1d(c.id, dim_base(c.bounce, 0u) + DIM_MIS_CHOICE) < c_l;
-        if (choose_light) {
-            out.radiance += light_estimate(c, 0u, f32(n_light), f32(n_dir)) / c_l;
-            dir_count = 0u;
-        } else {
-            dir_count = 1u;
-        }
-        n_light = 0u;
-    }
-    for (var j = 0u; j < min(n_light, 64u); j += 1u) {
-        out.radiance += light_estimate(c, j, f32(n_light), select(0.0, f32(n_dir), mis)) / f32(n_light);
-    }
+    let plan = strategy_plan(c);
+    out.radiance = shade_lights(c, plan);
     // Direction samples: trace, and count what they find (weighted against light sampling under MIS).
     // Sample 0 is also the path's continuation; a strategy that traces no direction here (light sampling,
     // or one-sample MIS that chose the light) still traces it, for the continuation only (its emission is
     // not counted: NEE already did). One trace site serves both — on lavapipe every call site's code runs
     // whether or not a lane needs it, so a separate continuation trace would cost a third traversal.
-    let dir_scale = select(1.0 / f32(max(n_dir, 1u)), 1.0 / (1.0 - f32(params.light_samples) / f32(params.light_samples + n_dir)), one_sample);
-    let n_traced = max(dir_count, select(0u, 1u, want_next));
+    let n_traced = max(plan.dir_count, select(0u, 1u, want_next));
     for (var j = 0u; j < min(n_traced, 64u); j += 1u) {
         let ds = direction_sample(c, j);
         let wl = ds.xyz;
@@ -191,10 +220,9 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
         let o = spawn_origin(c.x, w);
         rays_traced += 1u;
         let hit = trace_closest(o, w, F32_MAX);
-        let found = found_emission(c, o, w, hit);
-        var weight = 1.0;
-        if (mis) { weight = mis_weight(f32(n_dir), pdf, f32(params.light_samples), found.p_light); }
-        if (j < dir_count) { out.radiance += weight * found.le * f * wl.z / pdf * dir_scale; }
+        let found = found_emission(c.x.p, o, w, hit);
+        let weight = direction_emission_weight(plan.n_dir, pdf, found.p_light);
+        if (j < plan.dir_count) { out.radiance += weight * found.le * f * wl.z / pdf * plan.dir_scale; }
         if (j == 0u && want_next) {
             out.next_valid = true;
             out.next_origin = o;

@@ -92,6 +92,91 @@ fn accumulate(a: ptr<function, Accum>, bad: ptr<function, u32>, v: vec3<f32>) {
     (*a).m2 += delta * (v - (*a).mean);
 }
 
+/// A path in the deferred design (baked path-tracing pipelines): the ray whose hit is the path's next vertex,
+/// and how to count the emission it finds there. The direction sample that continues a path is also the
+/// direction technique's sample of that vertex's direct light, so its emission is counted one step late, where
+/// the next vertex's one trace finds it: camera rays, continuations and emission share one trace site.
+struct PathRay {
+    id: SampleId,
+    bounce: u32,          // the vertex this ray finds
+    o: vec3<f32>,
+    d: vec3<f32>,
+    from_p: vec3<f32>,    // the shading point it leaves (for the light technique's pdf of what it finds)
+    dir_pdf: f32,         // pdf of the direction technique that chose d
+    emission_scale: f32,  // factor on the emission it finds (0: NEE counted it already)
+    beta: vec3<f32>,      // throughput, including f·cos/pdf of d
+    l: vec3<f32>,         // radiance gathered so far
+}
+
+fn camera_path_ray(px: vec2<u32>, id: SampleId) -> PathRay {
+    var r: PathRay;
+    r.id = id;
+    r.bounce = 0u;
+    r.o = params.cam_origin;
+    r.d = camera_direction(px, sample_2d(id, 0u));
+    r.from_p = params.cam_origin;
+    r.dir_pdf = 0.0;
+    r.emission_scale = 1.0;
+    r.beta = vec3<f32>(1.0);
+    r.l = vec3<f32>(0.0);
+    return r;
+}
+
+/// Traces the path's ray, counts the emission it finds, shades the vertex there (light samples) and sets the
+/// next ray. Returns false when the path has ended (its radiance is then complete in r.l).
+fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
+    let ray = *r;
+    rays_traced += 1u;
+    let hit = trace_closest(ray.o, ray.d, F32_MAX);
+    let found = found_emission(ray.from_p, ray.o, ray.d, hit);
+    var w = ray.emission_scale;
+    // The camera ray is no direction technique's sample: its emission counts in full.
+    if (ray.bounce > 0u) { w *= direction_emission_weight(params.bsdf_samples, ray.dir_pdf, found.p_light); }
+    (*r).l += ray.beta * (w * found.le);
+    if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
+    let x = found.surface;
+    let m = scene_material(x.material);
+    var c: ShadingCtx;
+    c.x = x;
+    c.frame = frame_from_normal(x.ns);
+    c.wo = to_local(c.frame, -ray.d);
+    c.brdf = material_bsdf(m, x.uv);
+    c.id = ray.id;
+    c.bounce = ray.bounce;
+    let plan = strategy_plan(c);
+    (*r).l += ray.beta * shade_lights(c, plan);
+    // The direction sample: the continuation, and (when its emission counts) the last vertex's direct light.
+    let want_next = ray.bounce + 1u < depth;
+    if (!want_next && plan.dir_count == 0u) { return false; }
+    let ds = direction_sample(c, 0u);
+    if (!(ds.w > 0.0)) { return false; }
+    let wd = to_world(c.frame, ds.xyz);
+    if (dot(wd, x.ng) <= 0.0) { return false; }
+    var beta = ray.beta * (bsdf_eval(c.brdf, c.wo, ds.xyz) * ds.z / ds.w);
+    if (want_next && ray.bounce + 1u >= params.rr_depth) {
+        // Russian roulette, decided before the ray is traced: a surviving path's emission is found with β/q.
+        let q = clamp(max(beta.x, max(beta.y, beta.z)), 0.05, 1.0);
+        if (sample_1d(c.id, dim_base(ray.bounce, 0u) + DIM_RR) >= q) { return false; }
+        beta /= q;
+    }
+    if (all(beta == vec3<f32>(0.0))) { return false; }
+    (*r).bounce = ray.bounce + 1u;
+    (*r).o = spawn_origin(x, wd);
+    (*r).d = wd;
+    (*r).from_p = x.p;
+    (*r).dir_pdf = ds.w;
+    (*r).emission_scale = select(0.0, plan.dir_scale, plan.dir_count > 0u);
+    (*r).beta = beta;
+    return true;
+}
+
+/// Whether this pipeline uses the deferred design: baked scenes (no BVH walks to keep in step), path tracing
+/// (direct mode would need a second loop iteration per sample), and one direction sample per vertex (fixed at
+/// pipeline creation; more would each need their own trace site).
+fn deferred_paths() -> bool {
+    return FLAT_SCENE && cfg_mode() == MODE_PATH && SPEC_ONE_DIRECTION == 1u;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     bvh_set_lane(lid);
@@ -103,7 +188,21 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
     let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);
     var a = accum[pixel];
     var bad = 0u;
-    if (FLAT_SCENE) {
+    if (deferred_paths()) {
+        // As below, one loop over vertices with restarts, but each iteration traces one ray (see PathRay).
+        var ray = camera_path_ray(px, SampleId(pixel, params.sample_base));
+        var started = 1u;
+        var done = 0u;
+        for (var it = 0u; it < n * (depth + 1u) && done < n; it += 1u) {
+            if (path_vertex(&ray, depth)) { continue; }
+            accumulate(&a, &bad, ray.l);
+            done += 1u;
+            if (started < n) {
+                ray = camera_path_ray(px, SampleId(pixel, params.sample_base + started));
+                started += 1u;
+            }
+        }
+    } else if (FLAT_SCENE) {
         // One loop over path vertices, not one per sample: a lane whose path ends starts its next sample at
         // once. lavapipe runs a loop's SIMD lanes until the last one is done, so with a loop per sample every
         // lane waited for the longest path among its neighbours'. (With a BVH, lanes that restart at different

@@ -10,6 +10,8 @@ override SPEC_LIGHT_SELECT: u32 = 0xffffffffu;
 override SPEC_HEURISTIC: u32 = 0xffffffffu;
 override SPEC_MIS_KIND: u32 = 0xffffffffu;
 override SPEC_SAMPLER: u32 = 0xffffffffu;
+/// 1 when a shading point takes at most one direction sample (`--bsdf-samples` ≤ 1), fixed at pipeline creation.
+override SPEC_ONE_DIRECTION: u32 = 0xffffffffu;
 
 fn cfg_mode() -> u32 { return select(params.mode, SPEC_MODE, SPEC_MODE != INVALID); }
 fn cfg_strategy() -> u32 { return select(params.strategy, SPEC_STRATEGY, SPEC_STRATEGY != INVALID); }

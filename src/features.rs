@@ -176,11 +176,11 @@ pub struct PipelineKey {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FixedSettings {
     /// Tags, in the order of the `SPEC_*` constants.
-    pub tags: [u32; 8],
+    pub tags: [u32; 9],
 }
 
 /// Names of the settings constants, in `FixedSettings::tags` order.
-pub const SETTINGS_CONSTANTS: [&str; 8] = [
+pub const SETTINGS_CONSTANTS: [&str; 9] = [
     "SPEC_MODE",
     "SPEC_STRATEGY",
     "SPEC_LIGHT_SAMPLING",
@@ -189,6 +189,7 @@ pub const SETTINGS_CONSTANTS: [&str; 8] = [
     "SPEC_HEURISTIC",
     "SPEC_MIS_KIND",
     "SPEC_SAMPLER",
+    "SPEC_ONE_DIRECTION",
 ];
 
 impl FixedSettings {
@@ -204,6 +205,7 @@ impl FixedSettings {
                 s.heuristic.tag(),
                 s.mis.tag(),
                 s.sampler.tag(),
+                u32::from(s.bsdf_samples <= 1),
             ],
         }
     }
