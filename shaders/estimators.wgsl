@@ -65,22 +65,30 @@ fn spawn_origin(x: Surface, w: vec3<f32>) -> vec3<f32> {
     return offset_ray_origin_scaled(x.p, select(-x.ng, x.ng, dot(w, x.ng) > 0.0), params.offset_scale);
 }
 
+/// What a light-technique sample found, and the sampled light's `omega` from the shading point (see LightSample).
+struct LightEstimate {
+    radiance: vec3<f32>,
+    omega: f32,
+}
+
 /// One light-technique sample: choose a light, sample it, test visibility, weight against the
 /// direction technique when `mis_n_dir` > 0 (its sample count; 0 = no MIS partner).
-fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f32> {
-    if (params.num_lights == 0u) { return vec3<f32>(0.0); }
+fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> LightEstimate {
+    var out = LightEstimate(vec3<f32>(0.0), 0.0);
+    if (params.num_lights == 0u) { return out; }
     let base = dim_base(c.bounce, j);
     let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT));
     let pmf = light_pmf(li);
     let u = vec3<f32>(sample_2d(c.id, base + DIM_LIGHT_UV), sample_1d(c.id, base + DIM_LIGHT_EXTRA));
     let ls = light_sample_li(li, c.x.p, u);
-    if (!(ls.pdf > 0.0) || !(pmf > 0.0)) { return vec3<f32>(0.0); }
+    out.omega = ls.omega;
+    if (!(ls.pdf > 0.0) || !(pmf > 0.0)) { return out; }
     // Reflection only: the light must be above both the shading and the geometric hemisphere.
     let cos_s = dot(ls.wi, c.x.ns);
-    if (cos_s <= 0.0 || dot(ls.wi, c.x.ng) <= 0.0) { return vec3<f32>(0.0); }
+    if (cos_s <= 0.0 || dot(ls.wi, c.x.ng) <= 0.0) { return out; }
     let wi_local = to_local(c.frame, ls.wi);
     let f = bsdf_eval(c.brdf, c.wo, wi_local);
-    if (all(f * ls.radiance == vec3<f32>(0.0))) { return vec3<f32>(0.0); }
+    if (all(f * ls.radiance == vec3<f32>(0.0))) { return out; }
     let o = spawn_origin(c.x, ls.wi);
     // The shadow ray runs from the offset origin o to the light point y and stops just short of y, so the
     // emitter itself is no occluder. Aim at y from o (not along wi from x.p): at grazing angles a ray
@@ -95,16 +103,17 @@ fn light_estimate(c: ShadingCtx, j: u32, n_light: f32, mis_n_dir: f32) -> vec3<f
         // 1e-5 of a short shadow ray far from the origin is not.
         let y_err = 64.0 * 1.2e-7 * (max(max(abs(c.x.p.x), abs(c.x.p.y)), abs(c.x.p.z)) + len);
         t_max = len - max(len * 1e-5, y_err);
-        if (t_max <= 0.0) { return vec3<f32>(0.0); }
+        if (t_max <= 0.0) { return out; }
     }
     rays_traced += 1u;
-    if (trace_any_except(o, shadow_dir, t_max, light_prim_ref(li))) { return vec3<f32>(0.0); }
+    if (trace_any_except(o, shadow_dir, t_max, light_prim_ref(li))) { return out; }
     let p_light = pmf * ls.pdf;
     var w = 1.0;
     if (mis_n_dir > 0.0 && !ls.delta) {
         w = mis_weight(n_light, p_light, mis_n_dir, direction_pdf(c, wi_local));
     }
-    return w * ls.radiance * f * cos_s / p_light;
+    out.radiance = w * ls.radiance * f * cos_s / p_light;
+    return out;
 }
 
 /// Emitted radiance found by a traced direction, and the light technique's pdf for it (with selection).
@@ -114,8 +123,9 @@ struct Found {
     surface: Surface,   // the hit's shading point (reused as the path's next vertex)
 }
 
-/// What the ray o + t·w leaving the shading point at `from_p` found at `hit`.
-fn found_emission(from_p: vec3<f32>, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
+/// What the ray o + t·w leaving the shading point at `from_p` found at `hit`. With `omega_known` (a constant at
+/// each call site), a light hit there is the one sampled at from_p, whose `omega` from there is `omega`.
+fn found_emission(from_p: vec3<f32>, o: vec3<f32>, w: vec3<f32>, hit: Hit, omega_known: bool, omega: f32) -> Found {
     var r: Found;
     r.le = vec3<f32>(0.0);
     r.p_light = 0.0;
@@ -132,7 +142,11 @@ fn found_emission(from_p: vec3<f32>, o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Fo
     r.le = material_emission(scene_material(y.material), y.uv);
     if (y.light != INVALID) {
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
-        r.p_light = light_pmf(y.light) * light_pdf_li(y.light, from_p, w, y.p, y.ng);
+        if (omega_known) {
+            r.p_light = light_pmf(y.light) * light_pdf_given_omega(y.light, from_p, w, y.p, y.ng, omega);
+        } else {
+            r.p_light = light_pmf(y.light) * light_pdf_li(y.light, from_p, w, y.p, y.ng);
+        }
     }
     return r;
 }
@@ -180,13 +194,22 @@ fn strategy_plan(c: ShadingCtx) -> Plan {
 }
 
 /// The light-technique half of shade(): `plan.light_runs` samples of the lights, each weighed against the
-/// direction technique under MIS.
-fn shade_lights(c: ShadingCtx, plan: Plan) -> vec3<f32> {
-    var l = vec3<f32>(0.0);
+/// direction technique under MIS. `omega` is the first sample's (see LightEstimate).
+fn shade_lights(c: ShadingCtx, plan: Plan) -> LightEstimate {
+    var out = LightEstimate(vec3<f32>(0.0), 0.0);
     for (var j = 0u; j < min(plan.light_runs, 64u); j += 1u) {
-        l += light_estimate(c, j, plan.light_n, plan.light_partner) / plan.light_div;
+        let e = light_estimate(c, j, plan.light_n, plan.light_partner);
+        out.radiance += e.radiance / plan.light_div;
+        if (j == 0u) { out.omega = e.omega; }
     }
-    return l;
+    return out;
+}
+
+/// Whether the `omega` of a vertex's first light sample serves the MIS pdf of whatever light its direction sample
+/// hits, at every vertex: one light (the one sampled), and a light sample taken at every vertex (not one-sample
+/// MIS). Fixed per pipeline.
+fn light_omega_reusable() -> bool {
+    return !MANY_LIGHTS && cfg_strategy() == STRATEGY_MIS && cfg_mis_kind() == MIS_MULTI;
 }
 
 /// The weight of emission found by a direction sample of pdf `dir_pdf`, whose light-technique pdf is `p_light`.
@@ -202,7 +225,7 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     var out: Shaded;
     out.next_valid = false;
     let plan = strategy_plan(c);
-    out.radiance = shade_lights(c, plan);
+    out.radiance = shade_lights(c, plan).radiance;
     // Direction samples: trace, and count what they find (weighted against light sampling under MIS).
     // Sample 0 is also the path's continuation; a strategy that traces no direction here (light sampling,
     // or one-sample MIS that chose the light) still traces it, for the continuation only (its emission is
@@ -220,7 +243,7 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
         let o = spawn_origin(c.x, w);
         rays_traced += 1u;
         let hit = trace_closest(o, w, F32_MAX);
-        let found = found_emission(c.x.p, o, w, hit);
+        let found = found_emission(c.x.p, o, w, hit, false, 0.0);
         let weight = direction_emission_weight(plan.n_dir, pdf, found.p_light);
         if (j < plan.dir_count) { out.radiance += weight * found.le * f * wl.z / pdf * plan.dir_scale; }
         if (j == 0u && want_next) {

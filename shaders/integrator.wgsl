@@ -104,6 +104,7 @@ struct PathRay {
     from_p: vec3<f32>,    // the shading point it leaves (for the light technique's pdf of what it finds)
     dir_pdf: f32,         // pdf of the direction technique that chose d
     emission_scale: f32,  // factor on the emission it finds (0: NEE counted it already)
+    light_omega: f32,     // `omega` of the light sampled at from_p (used where light_omega_reusable())
     beta: vec3<f32>,      // throughput, including f·cos/pdf of d
     l: vec3<f32>,         // radiance gathered so far
 }
@@ -117,6 +118,7 @@ fn camera_path_ray(px: vec2<u32>, id: SampleId) -> PathRay {
     r.from_p = params.cam_origin;
     r.dir_pdf = 0.0;
     r.emission_scale = 1.0;
+    r.light_omega = 0.0;
     r.beta = vec3<f32>(1.0);
     r.l = vec3<f32>(0.0);
     return r;
@@ -128,7 +130,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     let ray = *r;
     rays_traced += 1u;
     let hit = trace_closest(ray.o, ray.d, F32_MAX);
-    let found = found_emission(ray.from_p, ray.o, ray.d, hit);
+    let found = found_emission(ray.from_p, ray.o, ray.d, hit, light_omega_reusable(), ray.light_omega);
     var w = ray.emission_scale;
     // The camera ray is no direction technique's sample: its emission counts in full.
     if (ray.bounce > 0u) { w *= direction_emission_weight(params.bsdf_samples, ray.dir_pdf, found.p_light); }
@@ -144,7 +146,8 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     c.id = ray.id;
     c.bounce = ray.bounce;
     let plan = strategy_plan(c);
-    (*r).l += ray.beta * shade_lights(c, plan);
+    let lights = shade_lights(c, plan);
+    (*r).l += ray.beta * lights.radiance;
     // The direction sample: the continuation, and (when its emission counts) the last vertex's direct light.
     let want_next = ray.bounce + 1u < depth;
     if (!want_next && plan.dir_count == 0u) { return false; }
@@ -166,6 +169,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     (*r).from_p = x.p;
     (*r).dir_pdf = ds.w;
     (*r).emission_scale = select(0.0, plan.dir_scale, plan.dir_count > 0u);
+    (*r).light_omega = lights.omega;
     (*r).beta = beta;
     return true;
 }

@@ -4,17 +4,20 @@
 
 /// A sampled direction towards a light: unit wi, distance to the light point (F32_MAX for distant
 /// lights), the radiance arriving along wi (for delta lights: intensity/d² or irradiance), the pdf in
-/// solid angle (0 = no sample), and whether the technique is a delta distribution.
+/// solid angle (0 = no sample), whether the technique is a delta distribution, and `omega`: for an area light,
+/// what its pdf at any point depends on, as `light_pdf_given_omega` takes it (Ω > 0 when sampled uniformly in
+/// solid angle, −1 when by area, 0 when p sees no light from it).
 struct LightSample {
     wi: vec3<f32>,
     dist: f32,
     radiance: vec3<f32>,
     pdf: f32,
     delta: bool,
+    omega: f32,
 }
 
 fn no_light_sample() -> LightSample {
-    return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, false);
+    return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, false, 0.0);
 }
 
 /// The primitive an area light is (a primitive reference), or INVALID for delta and environment lights.
@@ -80,7 +83,7 @@ fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32
     let wi = v / dist;
     let cos_l = dot(-wi, n_y);
     if (!(cos_l > 0.0) || !(d2 > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, false);
+    return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, false, -1.0);
 }
 
 /// Triangle light, uniform by area (barycentrics by Heitz's low-distortion map). Measure: area → solid angle.
@@ -153,7 +156,7 @@ fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let n = normalize(y - s.center);
     let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
     let emitted = material_emission(scene_material(s.material), uv);
-    return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), false);
+    return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), false, TWO_PI * omc);
 }
 
 // ---- triangle and quad lights by solid angle (spherical triangle / spherical rectangle) ----
@@ -210,7 +213,7 @@ fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> Ligh
     let sh = scene_tri_shading(prim);
     let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
     let emitted = material_emission(scene_material(sh.material), uv);
-    return LightSample(wi, t, emitted, 1.0 / omega, false);
+    return LightSample(wi, t, emitted, 1.0 / omega, false, omega);
 }
 
 /// A quad light's frame for spherical-rectangle sampling: unit edges x, y, front normal z, edge lengths, and
@@ -256,7 +259,7 @@ fn quad_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSam
     let dist = length(v);
     let st = vec2<f32>((xy.x - f.rect.x0) / f.lu, (xy.y - f.rect.y0) / f.lv);
     let emitted = material_emission(scene_material(q.material), st);
-    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, false);
+    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, false, f.rect.omega);
 }
 
 // ---- delta lights ----
@@ -267,7 +270,7 @@ fn point_sample_li(l: Light, p: vec3<f32>) -> LightSample {
     let d2 = dot(v, v);
     if (!(d2 > 0.0)) { return no_light_sample(); }
     let dist = sqrt(d2);
-    return LightSample(v / dist, dist, l.radiance / d2, 1.0, true);
+    return LightSample(v / dist, dist, l.radiance / d2, 1.0, true, -1.0);
 }
 
 /// Spot light: a point light times a smooth falloff between the outer and inner cone.
@@ -280,7 +283,7 @@ fn spot_sample_li(l: Light, p: vec3<f32>) -> LightSample {
 
 /// Directional light: light travelling along `direction`, irradiance in `radiance`.
 fn directional_sample_li(l: Light) -> LightSample {
-    return LightSample(-l.direction, F32_MAX, l.radiance, 1.0, true);
+    return LightSample(-l.direction, F32_MAX, l.radiance, 1.0, true, -1.0);
 }
 
 // ---- environment ----
@@ -332,7 +335,7 @@ fn env_pdf(w: vec3<f32>) -> f32 {
 fn env_sample_li(u: vec3<f32>) -> LightSample {
     if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) {
         let wi = square_to_uniform_sphere(u.xy);
-        return LightSample(wi, F32_MAX, env_eval(wi), INV_FOUR_PI, false);
+        return LightSample(wi, F32_MAX, env_eval(wi), INV_FOUR_PI, false, -1.0);
     }
     let n = params.env_width * params.env_height;
     let pick = alias_sample2(0u, n, u.z, u.y, true);
@@ -343,7 +346,7 @@ fn env_sample_li(u: vec3<f32>) -> LightSample {
     let texel = env_texels[pick.index];
     let pdf = texel.w / (2.0 * PI * PI * max(length(wi.xz), 1e-7));
     if (!(pdf > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, false);
+    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, false, -1.0);
 }
 
 // ---- the light technique as a whole ----
@@ -385,42 +388,53 @@ fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32
     let l = scene_light(i);
     if (l.kind == LIGHT_ENVIRONMENT) { return env_pdf(wi); }
     if (l.kind > LIGHT_QUAD) { return 0.0; }
+    return light_pdf_given_omega(i, p, wi, y, n_y, light_omega(i, p));
+}
+
+/// The `omega` of `LightSample` for area light i seen from p: what its sampler decides there.
+fn light_omega(i: u32, p: vec3<f32>) -> f32 {
+    let l = scene_light(i);
     let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
+    if (HAS_TRIANGLE_LIGHTS && l.kind == LIGHT_TRIANGLE) {
+        let tp = scene_tri_positions(l.prim);
+        if (solid_angle) { return triangle_light_omega(tp.v0, tp.v1, tp.v2, p); }
+        return select(0.0, -1.0, dot(p - tp.v0, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)) > 0.0);
+    }
+    if (HAS_QUAD_LIGHTS && l.kind == LIGHT_QUAD) {
+        let q = scene_quad(l.prim);
+        if (solid_angle) { return quad_light_frame(q, p).rect.omega; }
+        return select(0.0, -1.0, dot(p - q.corner, cross(q.edge_u, q.edge_v)) > 0.0);
+    }
+    if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE) {
+        let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
+        return select(-1.0, TWO_PI * omc, solid_angle && omc > 0.0);
+    }
+    return 0.0;
+}
+
+/// `light_pdf_li` for an area light whose `omega` from p is known (a light sample taken at p returns it: the
+/// pdf of a direction that hits the same light from the same point needs no second spherical-polygon setup).
+fn light_pdf_given_omega(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, omega: f32) -> f32 {
+    if (omega > 0.0) { return 1.0 / omega; }
+    if (!(omega < 0.0)) { return 0.0; }
+    // By area: d² / (A·cos_l).
+    let l = scene_light(i);
     let v = y - p;
     let d2 = dot(v, v);
     if (HAS_TRIANGLE_LIGHTS && l.kind == LIGHT_TRIANGLE) {
         let tp = scene_tri_positions(l.prim);
-        let v0 = tp.v0;
-        let v1 = tp.v1;
-        let v2 = tp.v2;
-        let n = cross(v1 - v0, v2 - v0);
-        if (solid_angle) {
-            let omega = triangle_light_omega(v0, v1, v2, p);
-            if (omega == 0.0) { return 0.0; }
-            if (omega > 0.0) { return 1.0 / omega; }
-        } else if (!(dot(p - v0, n) > 0.0)) { return 0.0; }
-        // Area: (2/|n|)·d² / cos_l with cos_l = |wi·n|/|n|.
-        let c = abs(dot(wi, n));
+        // (2/|n|)·d² / cos_l with cos_l = |wi·n|/|n|.
+        let c = abs(dot(wi, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)));
         if (!(c > 0.0)) { return 0.0; }
         return 2.0 * d2 / c;
     }
     if (HAS_QUAD_LIGHTS && l.kind == LIGHT_QUAD) {
         let q = scene_quad(l.prim);
-        let n = cross(q.edge_u, q.edge_v);
-        if (solid_angle) {
-            let f = quad_light_frame(q, p);
-            if (f.rect.omega == 0.0) { return 0.0; }
-            if (f.rect.omega > 0.0) { return 1.0 / f.rect.omega; }
-        } else if (!(dot(p - q.corner, n) > 0.0)) { return 0.0; }
-        let c = abs(dot(wi, n));
+        let c = abs(dot(wi, cross(q.edge_u, q.edge_v)));
         if (!(c > 0.0)) { return 0.0; }
         return d2 / c;
     }
     if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE) {
-        if (solid_angle) {
-            let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
-            if (omc > 0.0) { return square_to_uniform_cone_pdf(omc); }
-        }
         let cos_l = abs(dot(wi, n_y));
         if (!(cos_l > 0.0)) { return 0.0; }
         return d2 / (l.area * cos_l);

@@ -267,11 +267,11 @@ fn spherical_rect_setup(x0: f32, y0: f32, w: f32, hgt: f32, h: f32) -> Spherical
     r.a1 = r.a0 + la;
     r.b1 = r.b0 + lb;
     r.straddles = r.b0 < 0.0 && r.b1 > 0.0;
-    if (r.straddles) {
-        r.cos_pair = atan2_accurate(r.b0, h) + atan2_accurate(r.b1, h);
-    } else {
-        r.cos_pair = atan2_accurate(h, abs(r.b0)) + atan2_accurate(h, abs(r.b1));
-    }
+    // Straddling: atan(b0/h) + atan(b1/h); else atan(h/|b0|) + atan(h/|b1|). One pair of atan2 calls with the
+    // arguments selected (on lavapipe both sides of an if run).
+    let s = r.straddles;
+    r.cos_pair = atan2_accurate(select(h, r.b0, s), select(abs(r.b0), h, s))
+        + atan2_accurate(select(h, r.b1, s), select(abs(r.b1), h, s));
     // β1 − β0: the angle between (b0, h) and (b1, h), from the edge length (no cancellation).
     r.beta_diff = atan2_accurate(h * lb, h * h + r.b0 * r.b1);
     r.psi0 = spherical_rect_psi(r.a0, r.b0, r.b1, h);
@@ -307,16 +307,20 @@ fn square_to_spherical_rectangle(u: vec2<f32>, r: SphericalRect) -> vec2<f32> {
     let dd2 = a * a + r.h * r.h;
     let r0 = sqrt(dd2 + r.b0 * r.b0);
     let r1 = sqrt(dd2 + r.b1 * r.b1);
-    let h0 = r.b0 / r0;
-    let h1 = r.b1 / r1;
-    // 1 − hi and 1 + hi without cancellation: 1 − b/r = dd²/(r (r + b)) for b > 0, and symmetrically.
-    let om0 = select(1.0 - h0, dd2 / (r0 * (r0 + r.b0)), r.b0 > 0.0);
-    let om1 = select(1.0 - h1, dd2 / (r1 * (r1 + r.b1)), r.b1 > 0.0);
-    let op0 = select(1.0 + h0, dd2 / (r0 * (r0 - r.b0)), r.b0 < 0.0);
-    let op1 = select(1.0 + h1, dd2 / (r1 * (r1 - r.b1)), r.b1 < 0.0);
-    let hv = mix(h0, h1, u.y);
+    let inv_r0 = 1.0 / r0;
+    let inv_r1 = 1.0 / r1;
+    // 1 ∓ hi = (ri ∓ bi)/ri without cancellation: ri + |bi| directly, ri − |bi| = dd²/(ri + |bi|).
+    let far0 = r0 + abs(r.b0);
+    let far1 = r1 + abs(r.b1);
+    let near0 = dd2 / far0;
+    let near1 = dd2 / far1;
+    let om0 = select(far0, near0, r.b0 > 0.0) * inv_r0;
+    let om1 = select(far1, near1, r.b1 > 0.0) * inv_r1;
+    let op0 = select(far0, near0, r.b0 < 0.0) * inv_r0;
+    let op1 = select(far1, near1, r.b1 < 0.0) * inv_r1;
+    let hv = mix(r.b0 * inv_r0, r.b1 * inv_r1, u.y);
     let one_minus_hv2 = mix(om0, om1, u.y) * mix(op0, op1, u.y);
-    let b = clamp(hv * sqrt(dd2) / sqrt(one_minus_hv2), r.b0, r.b1);
+    let b = clamp(hv * sqrt(dd2 / one_minus_hv2), r.b0, r.b1);
     return select(vec2<f32>(a, b), vec2<f32>(b, a), r.swap);
 }
 fn square_to_spherical_rectangle_pdf(r: SphericalRect) -> f32 { return 1.0 / r.omega; }

@@ -571,14 +571,6 @@ pub fn film_complete(film: &Film, spp: u32) -> bool {
     film.count.iter().zip(&film.nonfinite).all(|(c, b)| c + b == spp)
 }
 
-/// The dispatch size to start from.
-pub fn default_dispatch_spp(mode: Mode) -> u32 {
-    match mode {
-        Mode::Direct => 16,
-        Mode::Path => 4,
-    }
-}
-
 // ---------------------------------------------------------------------------------------------------------------
 // Results.
 
@@ -907,7 +899,6 @@ fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResul
     let mut rows = vec![];
     let mut heatmaps = vec![];
     let pixels = (g.width * g.height) as f64;
-    let mut dispatch_spp = if g.dispatch_spp > 0 { g.dispatch_spp } else { default_dispatch_spp(g.mode) };
     for settings in &configs {
         let label = g.label(settings);
         // Compile (or find) the pipeline, then one warm-up sample; both timed apart from the measurements.
@@ -921,6 +912,8 @@ fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResul
         };
         r.prepare()?;
         r.warm_up(ctx).map_err(|e| e.to_string())?;
+        // The renderer's own dispatch size (as `mislab render` uses), unless the group fixes one.
+        let mut dispatch_spp = if g.dispatch_spp > 0 { g.dispatch_spp } else { r.max_dispatch_spp() };
         let compile_seconds = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         r.render(ctx, 1).map_err(|e| e.to_string())?;

@@ -2,7 +2,7 @@
 //! written as linear EXR whose header records the sample count, the render time, the scene and every setting
 //! (custom attributes); and reading such references back for `mislab bench`.
 
-use crate::bench::{default_dispatch_spp, film_complete, TimedRender};
+use crate::bench::{film_complete, TimedRender};
 use crate::film::Film;
 use crate::gpu::GpuContext;
 use crate::gpu_scene::{GpuScene, SceneData};
@@ -126,7 +126,7 @@ pub fn render_reference(
 ) -> Result<(Film, RenderStats), String> {
     let gpu_scene = GpuScene::upload(ctx, SceneData::build(scene)).map_err(|e| e.to_string())?;
     let mut r = Renderer::new(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?;
-    let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { default_dispatch_spp(settings.mode) };
+    let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { r.max_dispatch_spp() };
     for _attempt in 0..8 {
         r.reset();
         let timed = TimedRender::new(ctx, dispatch);
