@@ -71,6 +71,9 @@ pub struct BenchArgs {
     /// MIS flavours to compare (comma list: multi, one).
     #[arg(long = "mis", value_delimiter = ',')]
     pub mis_kinds: Vec<MisKind>,
+    /// Russian-roulette start depths to compare (comma list; default 3, as `render --rr-depth`).
+    #[arg(long, value_delimiter = ',')]
+    pub rr_depths: Vec<u32>,
     /// direct or path.
     #[arg(long, value_enum, default_value_t = Mode::Direct)]
     pub mode: Mode,
@@ -152,6 +155,8 @@ pub struct BenchGroup {
     pub light_selects: Vec<LightSelect>,
     /// MIS flavours.
     pub mis: Vec<MisKind>,
+    /// Russian-roulette start depths.
+    pub rr_depths: Vec<u32>,
 }
 
 impl Default for BenchGroup {
@@ -180,6 +185,7 @@ impl Default for BenchGroup {
             env_samplings: vec![],
             light_selects: vec![],
             mis: vec![],
+            rr_depths: vec![],
         }
     }
 }
@@ -202,6 +208,9 @@ impl BenchGroup {
                 v.to_vec()
             }
         }
+        fn pairs<A: Copy, B: Copy>(a: &[A], b: &[B]) -> Vec<(A, B)> {
+            a.iter().flat_map(|&x| b.iter().map(move |&y| (x, y))).collect()
+        }
         let d = Settings::default();
         let mut out = vec![];
         for &strategy in &or(&self.strategies, d.strategy) {
@@ -210,7 +219,7 @@ impl BenchGroup {
                     for &light_sampling in &or(&self.light_samplings, d.light_sampling) {
                         for &env_sampling in &or(&self.env_samplings, d.env_sampling) {
                             for &light_select in &or(&self.light_selects, d.light_select) {
-                                for &mis in &or(&self.mis, d.mis) {
+                                for (mis, rr_depth) in pairs(&or(&self.mis, d.mis), &or(&self.rr_depths, d.rr_depth)) {
                                     out.push(Settings {
                                         width: self.width,
                                         height: self.height,
@@ -223,6 +232,7 @@ impl BenchGroup {
                                         env_sampling,
                                         light_select,
                                         mis,
+                                        rr_depth,
                                         ..d.clone()
                                     });
                                 }
@@ -255,6 +265,10 @@ impl BenchGroup {
         }
         if self.mis.len() > 1 {
             parts.push(s.mis.name());
+        }
+        let rr = format!("rr{}", s.rr_depth);
+        if self.rr_depths.len() > 1 {
+            parts.push(&rr);
         }
         if self.samplers.len() > 1 {
             parts.push(s.sampler.name());
@@ -443,6 +457,7 @@ impl BenchArgs {
                 env_samplings: self.env_samplings.clone(),
                 light_selects: self.light_selects.clone(),
                 mis: self.mis_kinds.clone(),
+                rr_depths: self.rr_depths.clone(),
             }],
         };
         if self.suite.is_some() {
@@ -599,6 +614,8 @@ pub struct BenchRow {
     pub light_select: String,
     /// MIS flavour.
     pub mis: String,
+    /// Russian roulette from this depth.
+    pub rr_depth: u32,
     /// Film width.
     pub width: u32,
     /// Film height.
@@ -648,6 +665,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "env_sampling",
     "light_select",
     "mis",
+    "rr_depth",
     "width",
     "height",
     "spp",
@@ -691,6 +709,7 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             r.env_sampling.clone(),
             r.light_select.clone(),
             r.mis.clone(),
+            r.rr_depth.to_string(),
             r.width.to_string(),
             r.height.to_string(),
             r.spp.to_string(),
@@ -952,6 +971,7 @@ fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResul
                     env_sampling: settings.env_sampling.name().into(),
                     light_select: settings.light_select.name().into(),
                     mis: settings.mis.name().into(),
+                    rr_depth: settings.rr_depth,
                     width: g.width,
                     height: g.height,
                     spp: point.spp,
