@@ -2,7 +2,12 @@
 // real one per scene, every primitive's intersection test unrolled with its data as literals; this stub stands in
 // for modules built without a scene (the generic pipeline, probes), where FLAT_SCENE is false.
 
-/// Traversal of a baked scene (FLAT_SCENE): never called for a scene that was not baked.
-fn baked_traverse(r: TraceRay, start: Hit, any_hit: bool, skip: u32) -> Hit {
+/// Closest hit of a baked scene (FLAT_SCENE) up to start.t, ignoring primitive `skip`.
+fn baked_traverse(r: TraceRay, start: Hit, skip: u32) -> Hit {
     return start;
+}
+
+/// Shadow-ray test of a baked scene: whether anything but `skip` is hit with t in (0, t_max).
+fn baked_occluded(r: TraceRay, t_max: f32, skip: u32) -> bool {
+    return false;
 }

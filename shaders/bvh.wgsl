@@ -124,6 +124,18 @@ fn tri_hit(u: f32, v: f32, w: f32, az: f32, bz: f32, cz: f32, t_max: f32) -> vec
     return select(vec4<f32>(0.0), vec4<f32>(t, v * inv_det, w * inv_det, 1.0), hit);
 }
 
+/// Clips the ray parameter interval `span` to the half-space n·x ≤ dist (unit n): one face of a convex solid
+/// (src/convex_solids.rs; Haines 1991). The interval is empty (x ≥ y) once the ray misses the solid.
+fn clip_to_half_space(span: vec2<f32>, r: TraceRay, n: vec3<f32>, dist: f32) -> vec2<f32> {
+    let dn = dot(n, r.d);
+    let s = dist - dot(n, r.o);   // ≥ 0 when the origin is inside
+    let t = s / dn;
+    let enter = select(span.x, max(span.x, t), dn < 0.0);
+    let exit = select(span.y, min(span.y, t), dn > 0.0);
+    // Parallel to the face: all or nothing.
+    return select(vec2<f32>(enter, exit), vec2<f32>(1.0, 0.0), dn == 0.0 && s < 0.0);
+}
+
 /// Ray–sphere test, the cancellation-free form of Haines et al. 2019, "Precision Improvements for Ray/Sphere
 /// Intersection" (Ray Tracing Gems ch. 7, eqs. 7.9–7.14): the discriminant from the distance of the centre to the
 /// ray's line (accurate for far/small spheres), the roots as c/q and q/a. Returns (t, 0, 0, 1) for the nearest
@@ -211,7 +223,11 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
     }
     let r = trace_ray_setup(o, d);
     if FLAT_SCENE {
-        return baked_traverse(r, hit, any_hit, skip);
+        // (any_hit is a constant at every call site: only one of these survives inlining.)
+        if any_hit {
+            return Hit(t_max, select(INVALID, 0u, baked_occluded(r, t_max, skip)), 0.0, 0.0);
+        }
+        return baked_traverse(r, hit, skip);
     }
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;

@@ -13,6 +13,7 @@
 //! The storage buffers stay bound: shading (`surface_at`) reads them once per hit, and the generic pipeline (the
 //! viewer's) never calls the baked function.
 
+use crate::convex_solids::convex_solids;
 use crate::gpu_scene::SceneData;
 use crate::gpu_types::*;
 use glam::Vec3;
@@ -31,17 +32,6 @@ fn lit(x: f32) -> String {
 
 fn vec3_lit(v: Vec3) -> String {
     format!("vec3<f32>({}, {}, {})", lit(v.x), lit(v.y), lit(v.z))
-}
-
-/// Keeps the closer hit of one primitive's test (`call` yields the (t, b1, b2, hit) vector), unless it is `skip`.
-/// Selects, no branches: lavapipe executes a branch's body whether or not a lane takes it, plus mask upkeep; and an
-/// early return for any-hit rays saves nothing there.
-fn keep_hit(out: &mut String, prim: u32, call: &str) {
-    let _ = writeln!(
-        out,
-        "    {{ let h = {call}; let take = h.w != 0.0 && skip != {prim}u; \
-         hit = Hit(select(hit.t, h.x, take), select(hit.prim, {prim}u, take), select(hit.b1, h.y, take), select(hit.b2, h.z, take)); }}"
-    );
 }
 
 /// Distinct vertices (by bit pattern) and undirected edges of the triangles, in first-use order.
@@ -188,17 +178,49 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     Some((out, baked_traverse_source(data)))
 }
 
-/// `baked_traverse` for `data`: every primitive's test with its data as literals.
+/// `baked_traverse` (closest hit) and `baked_occluded` (shadow rays) for `data`: every primitive's test with its
+/// data as literals.
 fn baked_traverse_source(data: &SceneData) -> String {
     let mut out = String::from(
         "// baked_geometry.wgsl, generated for one scene by src/baked.rs: every intersection test, unrolled.\n\n\
-         fn baked_traverse(r: TraceRay, start: Hit, any_hit: bool, skip: u32) -> Hit {\n    var hit = start;\n",
+         fn baked_traverse(r: TraceRay, start: Hit, skip: u32) -> Hit {\n    var hit = start;\n",
     );
+    primitive_tests(data, &mut out, Query::Closest);
+    out += "    return hit;\n}\n\n\
+            fn baked_occluded(r: TraceRay, t_max: f32, skip: u32) -> bool {\n    var occluded = false;\n";
+    primitive_tests(data, &mut out, Query::Occluded);
+    out += "    return occluded;\n}\n";
+    out
+}
+
+/// What a generated traversal computes.
+#[derive(Clone, Copy, PartialEq)]
+enum Query {
+    /// The closest hit, into `hit`.
+    Closest,
+    /// Whether anything but `skip` blocks (0, t_max), into `occluded`.
+    Occluded,
+}
+
+/// Appends every primitive's test for `query`.
+fn primitive_tests(data: &SceneData, out: &mut String, query: Query) {
     let mesh = MeshTopology::of(&data.tri_verts, data.tri_shading.len());
     // Each vertex and edge is emitted just before the first triangle that needs it, so fewer values are live
     // at once (spilling them costs more than recomputing would).
     let (mut have_v, mut have_e) = (vec![false; mesh.vertices.len()], vec![false; mesh.edges.len()]);
+    // Shadow rays test closed convex meshes (not lights) as solids: a few plane clips instead of their triangles.
+    let solids = match query {
+        Query::Occluded => {
+            convex_solids(&data.tri_verts, data.tri_shading.len(), |t| data.tri_shading[t].light != INVALID)
+        }
+        Query::Closest => vec![],
+    };
+    let in_solid: Vec<bool> =
+        (0..mesh.corners.len()).map(|t| solids.iter().any(|s| s.triangles.contains(&t))).collect();
     for (i, [a, b, c]) in mesh.corners.iter().enumerate() {
+        if in_solid[i] {
+            continue;
+        }
         for v in [*a, *b, *c] {
             if !std::mem::replace(&mut have_v[v], true) {
                 let _ = writeln!(out, "    let v{v} = tri_vertex(r, {});", vec3_lit(mesh.vertices[v]));
@@ -212,12 +234,25 @@ fn baked_traverse_source(data: &SceneData) -> String {
             }
         }
         let (u, v, w) = (mesh.edge_expr(*c, *b), mesh.edge_expr(*a, *c), mesh.edge_expr(*b, *a));
-        let call = format!("tri_hit({u}, {v}, {w}, v{a}.z, v{b}.z, v{c}.z, hit.t)");
-        keep_hit(&mut out, make_prim(PRIM_TRIANGLE, i as u32), &call);
+        let call = format!("tri_hit({u}, {v}, {w}, v{a}.z, v{b}.z, v{c}.z, T_MAX)");
+        test_prim(out, query, make_prim(PRIM_TRIANGLE, i as u32), &call);
+    }
+    for s in &solids {
+        out.push_str("    {\n        var span = vec2<f32>(0.0, t_max);\n");
+        for (n, d) in &s.planes {
+            let _ = writeln!(
+                out,
+                "        span = clip_to_half_space(span, r, {}, {});",
+                vec3_lit(n.as_vec3()),
+                lit(*d as f32)
+            );
+        }
+        let _ =
+            writeln!(out, "        occluded = occluded | (span.x < span.y); // triangles {:?}\n    }}", s.triangles);
     }
     for (i, s) in data.spheres.iter().enumerate() {
-        let call = format!("intersect_sphere(r.o, r.d, {}, {}, hit.t)", vec3_lit(s.center.into()), lit(s.radius));
-        keep_hit(&mut out, make_prim(PRIM_SPHERE, i as u32), &call);
+        let call = format!("intersect_sphere(r.o, r.d, {}, {}, T_MAX)", vec3_lit(s.center.into()), lit(s.radius));
+        test_prim(out, query, make_prim(PRIM_SPHERE, i as u32), &call);
     }
     for (i, q) in data.quads.iter().enumerate() {
         let (eu, ev) = (Vec3::from(q.edge_u), Vec3::from(q.edge_v));
@@ -227,14 +262,29 @@ fn baked_traverse_source(data: &SceneData) -> String {
             continue; // degenerate: `intersect_quad` never reports a hit for it either
         }
         let call = format!(
-            "intersect_parallelogram(r.o, r.d, {}, {}, {}, {}, hit.t)",
+            "intersect_parallelogram(r.o, r.d, {}, {}, {}, {}, T_MAX)",
             vec3_lit(q.corner.into()),
             vec3_lit(n),
             vec3_lit(ev.cross(n) * inv_nn),
             vec3_lit(n.cross(eu) * inv_nn)
         );
-        keep_hit(&mut out, make_prim(PRIM_QUAD, i as u32), &call);
+        test_prim(out, query, make_prim(PRIM_QUAD, i as u32), &call);
     }
-    out += "    return hit;\n}\n";
-    out
+}
+
+/// One primitive's test: `call` (with T_MAX for the ray's current extent) yields the (t, b1, b2, hit) vector.
+/// Selects, no branches: lavapipe executes a branch's body whether or not a lane takes it, plus mask upkeep; and
+/// an early return for shadow rays saves nothing there.
+fn test_prim(out: &mut String, query: Query, prim: u32, call: &str) {
+    let _ = match query {
+        Query::Closest => writeln!(
+            out,
+            "    {{ let h = {}; let take = h.w != 0.0 && skip != {prim}u; \
+             hit = Hit(select(hit.t, h.x, take), select(hit.prim, {prim}u, take), select(hit.b1, h.y, take), select(hit.b2, h.z, take)); }}",
+            call.replace("T_MAX", "hit.t")
+        ),
+        Query::Occluded => {
+            writeln!(out, "    occluded = occluded | (({}).w != 0.0 && skip != {prim}u);", call.replace("T_MAX", "t_max"))
+        }
+    };
 }

@@ -7,6 +7,7 @@ pub mod baked;
 pub mod bench;
 pub mod bvh;
 pub mod chi2;
+pub mod convex_solids;
 pub mod features;
 pub mod figure;
 pub mod film;
