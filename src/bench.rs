@@ -95,8 +95,8 @@ pub struct BenchArgs {
     /// Seeds per configuration (0, 1, …), for the spread.
     #[arg(long, default_value_t = 3)]
     pub seeds: u32,
-    /// Samples per pixel in one dispatch (default 16 direct, 4 path; halved automatically when lavapipe's loop
-    /// budget drops samples).
+    /// Samples per pixel in one dispatch (default: the renderer's, 16, or 4 for path tracing through a BVH; halved
+    /// automatically when lavapipe's loop budget drops samples).
     #[arg(long)]
     pub dispatch_spp: Option<u32>,
     /// Output directory.
