@@ -8,7 +8,6 @@
 struct Shaded {
     radiance: vec3<f32>,
     next_valid: bool,
-    next_origin: vec3<f32>,
     next_dir: vec3<f32>,
     next_weight: vec3<f32>,   // f·cos/pdf of the continuation direction
     next_hit: Hit,
@@ -23,6 +22,18 @@ struct ShadingCtx {
     brdf: BsdfParams,
     id: SampleId,
     bounce: u32,
+}
+
+/// The shading point x, with material m, seen along the ray direction d that found it.
+fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32) -> ShadingCtx {
+    var c: ShadingCtx;
+    c.x = x;
+    c.frame = frame_from_normal(x.ns);
+    c.wo = to_local(c.frame, -d);
+    c.brdf = material_bsdf(m, x.uv);
+    c.id = id;
+    c.bounce = bounce;
+    return c;
 }
 
 /// The direction technique a strategy uses: uniform, cosine, or the BSDF (also for light / mis).
@@ -248,7 +259,6 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
         if (j < plan.dir_count) { out.radiance += weight * found.le * f * wl.z / pdf * plan.dir_scale; }
         if (j == 0u && want_next) {
             out.next_valid = true;
-            out.next_origin = o;
             out.next_dir = w;
             out.next_weight = f * wl.z / pdf;
             out.next_hit = hit;

@@ -51,13 +51,7 @@ fn path_step(p: ptr<function, Path>, depth: u32) -> bool {
     let x = (*p).x;
     let m = scene_material(x.material);
     if (bounce == 0u && x.front) { (*p).l += material_emission(m, x.uv); }
-    var c: ShadingCtx;
-    c.x = x;
-    c.frame = frame_from_normal(x.ns);
-    c.wo = to_local(c.frame, -(*p).d);
-    c.brdf = material_bsdf(m, x.uv);
-    c.id = (*p).id;
-    c.bounce = bounce;
+    let c = shading_ctx(x, m, (*p).d, (*p).id, bounce);
     let want_next = bounce + 1u < depth;
     let s = shade(c, want_next);
     (*p).l += (*p).beta * s.radiance;
@@ -137,14 +131,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     (*r).l += ray.beta * (w * found.le);
     if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
     let x = found.surface;
-    let m = scene_material(x.material);
-    var c: ShadingCtx;
-    c.x = x;
-    c.frame = frame_from_normal(x.ns);
-    c.wo = to_local(c.frame, -ray.d);
-    c.brdf = material_bsdf(m, x.uv);
-    c.id = ray.id;
-    c.bounce = ray.bounce;
+    let c = shading_ctx(x, scene_material(x.material), ray.d, ray.id, ray.bounce);
     let plan = strategy_plan(c);
     let lights = shade_lights(c, plan);
     (*r).l += ray.beta * lights.radiance;
