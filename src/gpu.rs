@@ -61,7 +61,24 @@ fn summary(a: &wgpu::Adapter) -> AdapterSummary {
     AdapterSummary { name: i.name, device_type: i.device_type, driver: format!("{} {}", i.driver, i.driver_info) }
 }
 
+/// Mesa's implicit device-selection layer connects to a Wayland display while it lists the devices, and where no
+/// desktop session exists (CI, ssh, a container) libwayland then prints "error: XDG_RUNTIME_DIR is invalid or not
+/// set in the environment" twice per Vulkan instance — noise a user takes for mislab's error. mislab chooses its
+/// adapter itself (`WGPU_ADAPTER_NAME`, else by device type), so without a session the layer is switched off
+/// through its documented `NODEVICE_SELECT` variable: once, before this process makes any Vulkan call (every
+/// instance, the viewer's too, is made after `quiet_device_select_layer`), and never against the user's choice.
+pub fn quiet_device_select_layer() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let session = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+        if !session && std::env::var_os("NODEVICE_SELECT").is_none() {
+            std::env::set_var("NODEVICE_SELECT", "1");
+        }
+    });
+}
+
 fn vulkan_instance() -> wgpu::Instance {
+    quiet_device_select_layer();
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = wgpu::Backends::VULKAN;
     wgpu::Instance::new(desc)

@@ -10,7 +10,8 @@ use mislab::probe::{GeometryBuffers, Probe};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-const HELMET: &str = "/work/shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb";
+const HELMET: &str =
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
 /// Same-primitive hits must agree in t to this relative tolerance.
 const T_REL: f64 = 1e-5;
 /// Two primitives whose reference distances agree this closely are a tie: either may be reported.

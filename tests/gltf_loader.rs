@@ -8,8 +8,8 @@ use mislab::scene::{self, load, LoadOptions, Material, Mesh, PunctualLight, Scen
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
-const TESTDATA: &str = "/work/shared/testdata/gltf";
-const SCENES: &str = "/work/shared/scenes";
+const TESTDATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/gltf");
+const SCENES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/scenes");
 
 // ------------------------------------------------------------------------------------------------------
 // Helpers
@@ -453,7 +453,7 @@ fn unicode_file_name() {
 }
 
 // ------------------------------------------------------------------------------------------------------
-// The comparison scenes (numbers from /work/shared/scenes/*/README.md)
+// The comparison scenes (numbers from ../shared/scenes/*/README.md)
 
 #[test]
 fn veach_mis_scene() {

@@ -551,7 +551,7 @@ fn map_3x2() -> EnvMap {
     EnvMap { path: "3x2".into(), width: 3, height: 2, texels }
 }
 
-const HDR: &str = "/work/shared/testdata/env/hdr/noon_grass_1k.hdr";
+const HDR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/env/hdr/noon_grass_1k.hdr");
 
 fn hdr_map() -> EnvMap {
     mislab::scene::envmap::load_envmap(std::path::Path::new(HDR)).unwrap_or_else(|e| panic!("{HDR}: {e}")).0

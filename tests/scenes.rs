@@ -5,8 +5,8 @@ use mislab::scene::envmap::{direction_to_equirect, equirect_direction, load_envm
 use mislab::scene::{self, builtin, Environment, LoadOptions, Material, PunctualLight, Quad, Scene};
 use std::path::{Path, PathBuf};
 
-const TESTDATA_ENV: &str = "/work/shared/testdata/env";
-const GLTF_SCENES: &str = "/work/shared/scenes";
+const TESTDATA_ENV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/env");
+const GLTF_SCENES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/scenes");
 
 fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes")
