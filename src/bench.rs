@@ -8,14 +8,15 @@
 //! kernel loops over the samples of a dispatch, so a dispatch of many samples per pixel silently accumulates
 //! fewer. Rendering here splits the samples into small dispatches and checks every pixel's count at every point.
 
-use crate::film::Film;
 use crate::gpu::GpuContext;
 use crate::gpu_scene::{GpuScene, SceneData};
+use crate::gpu_timer::GpuTimer;
 use crate::metrics::{self, ErrorMetrics};
 use crate::reference::{self, SceneSpec};
-use crate::render::Renderer;
+use crate::render::{Renderer, Timing};
 use crate::samplers;
 use crate::settings::*;
+use crate::suite_inputs::{self, SuiteInputs};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -306,15 +307,16 @@ impl BenchGroup {
     }
 }
 
-/// Where the shared test data lives (environment maps, glTF models): `../shared/testdata` beside the crate.
-pub fn testdata_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata")
-}
-
 /// The lecture suite's groups at `width`×`height`, ladder `spp`, `seeds` seeds.
-pub fn lecture_suite(width: u32, height: u32, spp: &[u32], seeds: u32, reference_spp: u32) -> Vec<BenchGroup> {
-    let sky = testdata_dir().join("env/hdr/noon_grass_1k.hdr");
-    let helmet = testdata_dir().join("gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
+pub fn lecture_suite(
+    inputs: &SuiteInputs,
+    width: u32,
+    height: u32,
+    spp: &[u32],
+    seeds: u32,
+    reference_spp: u32,
+) -> Vec<BenchGroup> {
+    let sky = inputs.sky.clone();
     let base = BenchGroup { width, height, spp: spp.to_vec(), seeds, reference_spp, ..BenchGroup::default() };
     let all_samplers = SamplerKind::ALL.to_vec();
     vec![
@@ -340,10 +342,9 @@ pub fn lecture_suite(width: u32, height: u32, spp: &[u32], seeds: u32, reference
             ..base.clone()
         },
         BenchGroup {
-            // MIS here: light sampling alone cannot reach the helmet's emissive texture (not a light), so it would
-            // converge to something else than the reference.
-            name: "Environment: uniform vs importance (DamagedHelmet under noon_grass, MIS)".into(),
-            scene: helmet.to_string_lossy().into_owned(),
+            // MIS here, as a renderer would: the glossy and mirror-like spheres find the sun through BSDF samples.
+            name: "Environment: uniform vs importance (metal-rough spheres under noon_grass, MIS)".into(),
+            scene: inputs.spheres.to_string_lossy().into_owned(),
             env: Some(sky.clone()),
             strategies: vec![Strategy::Mis],
             env_samplings: vec![EnvSampling::Uniform, EnvSampling::Importance],
@@ -402,7 +403,15 @@ impl BenchArgs {
         let mut groups = match (self.suite, &self.config) {
             (Some(Suite::Lecture), _) => {
                 let spp = ladder.clone().unwrap_or_else(|| vec![1, 2, 4, 8, 16, 32, 64]);
-                lecture_suite(self.width.unwrap_or(128), self.height.unwrap_or(128), &spp, self.seeds, self.ref_spp)
+                let inputs = suite_inputs::write_to(&self.out.join("inputs"))?;
+                lecture_suite(
+                    &inputs,
+                    self.width.unwrap_or(128),
+                    self.height.unwrap_or(128),
+                    &spp,
+                    self.seeds,
+                    self.ref_spp,
+                )
             }
             (None, Some(path)) => {
                 let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -477,115 +486,6 @@ impl BenchArgs {
 // Timed, checked rendering.
 
 /// Seconds spent rendering.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Timing {
-    /// Sum of the render passes' GPU durations (timestamp queries); None without TIMESTAMP_QUERY.
-    pub gpu: Option<f64>,
-    /// Wall time of submitting and waiting (readbacks for metrics excluded).
-    pub wall: f64,
-    /// Rays traced.
-    pub rays: u64,
-}
-
-impl Timing {
-    /// GPU time where measured, else wall time.
-    pub fn seconds(&self) -> f64 {
-        self.gpu.unwrap_or(self.wall)
-    }
-}
-
-/// Dispatches per timestamp readback.
-const QUERY_PAIRS: u32 = 64;
-
-/// Renders through a `Renderer` in small dispatches (one submission each, since the frame parameters are written
-/// per submission), timing each pass with GPU timestamps.
-pub struct TimedRender {
-    query_set: Option<wgpu::QuerySet>,
-    resolve: Option<wgpu::Buffer>,
-    period_ns: f64,
-    /// Samples per pixel in one dispatch.
-    pub dispatch_spp: u32,
-}
-
-impl TimedRender {
-    /// Timestamp queries where the device has them.
-    pub fn new(ctx: &GpuContext, dispatch_spp: u32) -> TimedRender {
-        let (query_set, resolve) = if ctx.timestamps {
-            let qs = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("bench timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2 * QUERY_PAIRS,
-            });
-            let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("bench timestamps"),
-                size: 16 * QUERY_PAIRS as u64,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            (Some(qs), Some(buf))
-        } else {
-            (None, None)
-        };
-        TimedRender {
-            query_set,
-            resolve,
-            period_ns: ctx.queue.get_timestamp_period() as f64,
-            dispatch_spp: dispatch_spp.max(1),
-        }
-    }
-
-    fn read_gpu_seconds(&self, ctx: &GpuContext, pairs: u32) -> Result<f64, String> {
-        let (Some(qs), Some(buf)) = (&self.query_set, &self.resolve) else { return Ok(0.0) };
-        let mut enc = ctx.device.create_command_encoder(&Default::default());
-        enc.resolve_query_set(qs, 0..2 * pairs, buf, 0);
-        ctx.queue.submit([enc.finish()]);
-        let t: Vec<u64> = ctx.read_pod(buf, 2 * pairs as usize).map_err(|e| e.to_string())?;
-        Ok((0..pairs as usize).map(|k| t[2 * k + 1].saturating_sub(t[2 * k]) as f64 * self.period_ns * 1e-9).sum())
-    }
-
-    /// Renders `spp` more samples per pixel.
-    pub fn render(&self, ctx: &GpuContext, r: &mut Renderer, spp: u32) -> Result<Timing, String> {
-        let mut timing = Timing { gpu: self.query_set.as_ref().map(|_| 0.0), ..Timing::default() };
-        let rays_before = r.rays_total;
-        let mut left = spp;
-        let mut pairs = 0u32;
-        let height = r.settings.height;
-        while left > 0 {
-            let n = left.min(self.dispatch_spp);
-            let t0 = Instant::now();
-            let mut enc = ctx.device.create_command_encoder(&Default::default());
-            let writes = self.query_set.as_ref().map(|qs| wgpu::ComputePassTimestampWrites {
-                query_set: qs,
-                beginning_of_pass_write_index: Some(2 * pairs),
-                end_of_pass_write_index: Some(2 * pairs + 1),
-            });
-            r.encode_rows(&mut enc, n, 0, height, writes);
-            ctx.queue.submit([enc.finish()]);
-            ctx.wait().map_err(|e| e.to_string())?;
-            timing.wall += t0.elapsed().as_secs_f64();
-            r.samples += n;
-            left -= n;
-            pairs += 1;
-            if pairs == QUERY_PAIRS || left == 0 {
-                if let Some(g) = &mut timing.gpu {
-                    *g += self.read_gpu_seconds(ctx, pairs)?;
-                }
-                // Also bounds the device's 32-bit ray counter between readbacks.
-                r.collect_counters(ctx).map_err(|e| e.to_string())?;
-                pairs = 0;
-            }
-        }
-        timing.rays = r.rays_total - rays_before;
-        Ok(timing)
-    }
-}
-
-/// Whether every pixel holds `spp` samples (accumulated or counted as non-finite): lavapipe's loop budget can cut
-/// a dispatch short without an error.
-pub fn film_complete(film: &Film, spp: u32) -> bool {
-    film.count.iter().zip(&film.nonfinite).all(|(c, b)| c + b == spp)
-}
-
 // ---------------------------------------------------------------------------------------------------------------
 // Results.
 
@@ -939,11 +839,12 @@ fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResul
         let warmup_seconds = t1.elapsed().as_secs_f64();
         eprintln!("{} / {label}: pipeline ready in {compile_seconds:.2} s, warm-up {warmup_seconds:.2} s", g.name);
         let mut sum_heat: Option<Vec<f64>> = None;
+        let mut timer = GpuTimer::new(ctx, 64);
         for seed in 0..g.seeds {
             let mut attempt = 0;
             let seed_rows = loop {
-                let timed = TimedRender::new(ctx, dispatch_spp);
-                match run_seed(ctx, r, &timed, g, settings, seed, &reference) {
+                r.set_dispatch_spp(Some(dispatch_spp));
+                match run_seed(ctx, r, &mut timer, g, settings, seed, &reference) {
                     Ok(v) => break v,
                     Err(SeedError::Incomplete(spp)) if dispatch_spp > 1 && attempt < 8 => {
                         dispatch_spp /= 2;
@@ -1039,7 +940,7 @@ impl From<String> for SeedError {
 fn run_seed(
     ctx: &GpuContext,
     r: &mut Renderer,
-    timed: &TimedRender,
+    timer: &mut Option<GpuTimer>,
     g: &BenchGroup,
     settings: &Settings,
     seed: u32,
@@ -1055,16 +956,16 @@ fn run_seed(
     let mut cumulative = Timing { gpu: Some(0.0), ..Timing::default() };
     for (k, &requested) in ladder.iter().enumerate() {
         let spp = samplers::check_spp(settings.sampler, requested)?;
-        if !fixed && spp < r.samples {
+        if !fixed && spp < r.samples() {
             continue;
         }
         let timing = if fixed {
             r.reset();
-            r.sampler_spp = spp;
-            timed.render(ctx, r, spp)?
+            r.set_sampler_spp(spp);
+            r.render_timed(ctx, spp, timer.as_mut())?
         } else {
-            r.sampler_spp = samplers::DEFAULT_SAMPLER_SPP;
-            let t = timed.render(ctx, r, spp - r.samples)?;
+            r.set_sampler_spp(samplers::DEFAULT_SAMPLER_SPP);
+            let t = r.render_timed(ctx, spp - r.samples(), timer.as_mut())?;
             cumulative = Timing {
                 gpu: cumulative.gpu.zip(t.gpu).map(|(a, b)| a + b),
                 wall: cumulative.wall + t.wall,
@@ -1073,7 +974,7 @@ fn run_seed(
             cumulative
         };
         let film = r.film(ctx).map_err(|e| e.to_string())?;
-        if !film_complete(&film, spp) {
+        if !film.is_complete(spp) {
             return Err(SeedError::Incomplete(spp));
         }
         let m = metrics::compare(&film.mean, reference)?;

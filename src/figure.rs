@@ -136,16 +136,9 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
     save_png(&out, &args.output)
 }
 
-/// Renders `spp` samples per pixel in submissions of about 2^18 samples (short dispatches on lavapipe).
+/// Renders `spp` samples per pixel and reads the film back.
 fn render(ctx: &GpuContext, renderer: &mut Renderer, spp: u32) -> Result<Film, String> {
-    let pixels = renderer.settings.width * renderer.settings.height;
-    let chunk = ((1u32 << 18) / pixels).clamp(1, 64);
-    let mut left = spp;
-    while left > 0 {
-        let n = left.min(chunk);
-        renderer.render(ctx, n).map_err(|e| e.to_string())?;
-        left -= n;
-    }
+    renderer.render(ctx, spp)?;
     renderer.film(ctx).map_err(|e| e.to_string())
 }
 

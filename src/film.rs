@@ -87,6 +87,12 @@ impl Film {
         self.count.iter().zip(&self.nonfinite).map(|(c, b)| c + b).min().unwrap_or(0)
     }
 
+    /// Whether every pixel holds `spp` samples (accumulated or counted as non-finite): lavapipe's loop budget can
+    /// cut a dispatch short without an error.
+    pub fn is_complete(&self, spp: u32) -> bool {
+        self.count.iter().zip(&self.nonfinite).all(|(c, b)| c + b == spp)
+    }
+
     /// 8-bit sRGB pixels after exposure and tonemapping.
     pub fn to_rgb8(&self, exposure: f32, op: Tonemap) -> image::RgbImage {
         let mut img = image::RgbImage::new(self.width, self.height);

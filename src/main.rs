@@ -340,7 +340,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     let gpu_scene = GpuScene::upload(&ctx, data).map_err(|e| bad(format!("{}: {e}", args.scene.scene)))?;
     let mut renderer = Renderer::new(&ctx, &gpu_scene, scene.camera.clone(), settings.clone()).map_err(bad)?;
     if let Budget::Samples(n) = budget {
-        renderer.sampler_spp = n;
+        renderer.set_sampler_spp(n);
     }
     ctx.wait().map_err(|e| bad(e.to_string()))?;
     let t_ready = Instant::now();

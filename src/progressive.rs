@@ -3,7 +3,7 @@
 //! progress responsive). Samples are merged one at a time on the device, so how they are split
 //! into submissions never changes the image.
 
-use crate::gpu::{GpuContext, GpuError};
+use crate::gpu::GpuContext;
 use crate::render::Renderer;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -43,13 +43,13 @@ pub fn run(
     budget: Budget,
     interrupt: &AtomicBool,
     mut progress: impl FnMut(u32, f64),
-) -> Result<RenderStats, GpuError> {
+) -> Result<RenderStats, String> {
     let start = Instant::now();
-    let start_samples = renderer.samples;
+    let start_samples = renderer.samples();
     let mut batch = 1u32;
     let mut interrupted = false;
     loop {
-        let done = renderer.samples - start_samples;
+        let done = renderer.samples() - start_samples;
         let elapsed = start.elapsed().as_secs_f64();
         let remaining = match budget {
             Budget::Samples(n) => n.saturating_sub(done),
@@ -80,16 +80,16 @@ pub fn run(
         let t0 = Instant::now();
         renderer.render(ctx, n)?;
         let dt = t0.elapsed().as_secs_f64();
-        progress(renderer.samples - start_samples, start.elapsed().as_secs_f64());
+        progress(renderer.samples() - start_samples, start.elapsed().as_secs_f64());
         // Size the next submission from the measured time per sample.
         let per = dt / n as f64;
         batch = ((TARGET_SUBMIT_SECONDS / per.max(1e-9)) as u32).clamp(1, 4096);
     }
     Ok(RenderStats {
-        spp: renderer.samples - start_samples,
+        spp: renderer.samples() - start_samples,
         seconds: start.elapsed().as_secs_f64(),
-        rays: renderer.rays_total,
-        nonfinite: renderer.nonfinite_total,
+        rays: renderer.rays_total(),
+        nonfinite: renderer.nonfinite_total(),
         interrupted,
     })
 }

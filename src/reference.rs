@@ -2,10 +2,10 @@
 //! written as linear EXR whose header records the sample count, the render time, the scene and every setting
 //! (custom attributes); and reading such references back for `mislab bench`.
 
-use crate::bench::{film_complete, TimedRender};
 use crate::film::Film;
 use crate::gpu::GpuContext;
 use crate::gpu_scene::{GpuScene, SceneData};
+use crate::gpu_timer::GpuTimer;
 use crate::progressive::{Budget, RenderStats};
 use crate::render::Renderer;
 use crate::scene::{self, Environment, LoadOptions, Scene};
@@ -129,16 +129,17 @@ pub fn render_reference(
     let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { r.max_dispatch_spp() };
     for _attempt in 0..8 {
         r.reset();
-        let timed = TimedRender::new(ctx, dispatch);
+        r.set_dispatch_spp(Some(dispatch));
+        let mut timer = GpuTimer::new(ctx, 64);
         let start = Instant::now();
         let (mut seconds, mut rays) = (0.0, 0u64);
         // Submissions of about a second, so a time budget is met closely.
         let mut chunk = dispatch;
         loop {
             let n = match budget {
-                Budget::Samples(total) => chunk.min(total - r.samples),
+                Budget::Samples(total) => chunk.min(total - r.samples()),
                 Budget::Time(t) => {
-                    if r.samples > 0 && start.elapsed() >= t {
+                    if r.samples() > 0 && start.elapsed() >= t {
                         0
                     } else {
                         chunk
@@ -148,21 +149,22 @@ pub fn render_reference(
             if n == 0 {
                 break;
             }
-            let t = timed.render(ctx, &mut r, n)?;
+            let t = r.render_timed(ctx, n, timer.as_mut())?;
             seconds += t.wall;
             rays += t.rays;
             if t.wall < 0.5 {
                 chunk = (chunk * 2).min(1 << 16);
             }
             if let Budget::Time(limit) = budget {
-                let per = seconds / r.samples as f64;
+                let per = seconds / r.samples() as f64;
                 let left = limit.saturating_sub(start.elapsed()).as_secs_f64();
                 chunk = chunk.min(((left / per.max(1e-9)).ceil() as u32).max(1));
             }
         }
         let film = r.film(ctx).map_err(|e| e.to_string())?;
-        if film_complete(&film, r.samples) {
-            let stats = RenderStats { spp: r.samples, seconds, rays, nonfinite: r.nonfinite_total, interrupted: false };
+        if film.is_complete(r.samples()) {
+            let stats =
+                RenderStats { spp: r.samples(), seconds, rays, nonfinite: r.nonfinite_total(), interrupted: false };
             return Ok((film, stats));
         }
         if dispatch == 1 {

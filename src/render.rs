@@ -5,10 +5,13 @@ use crate::features::{Features, PipelineKey};
 use crate::film::Film;
 use crate::gpu::{GpuContext, GpuError};
 use crate::gpu_scene::GpuScene;
+use crate::gpu_timer::GpuTimer;
 use crate::gpu_types::*;
+use crate::pipeline_cache::PipelineCache;
 use crate::scene::Camera;
 use crate::settings::{Mode, Settings};
 use crate::shaders;
+use std::time::Instant;
 
 /// WGSL files of the render entry point, in order.
 pub const RENDER_FILES: &[&str] = &[
@@ -49,36 +52,71 @@ pub fn render_source_for(data: &crate::gpu_scene::SceneData) -> String {
     }
 }
 
-/// A progressive renderer of one scene with one set of settings (change either → `reset`).
+/// Most pixel samples `Renderer::render` submits before it waits on the device: bounds each wait well below
+/// `gpu::DEVICE_WAIT_TIMEOUT` however long the render, and the device's 32-bit ray counter between readbacks.
+pub const PIXEL_SAMPLES_PER_WAIT: u64 = 1 << 22;
+
+/// What a timed render did (`Renderer::render_timed`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Sum of the render passes' GPU durations (timestamp queries); None without TIMESTAMP_QUERY.
+    pub gpu: Option<f64>,
+    /// Wall time of submitting and waiting (readbacks for metrics excluded).
+    pub wall: f64,
+    /// Rays traced.
+    pub rays: u64,
+}
+
+impl Timing {
+    /// GPU time where measured, else wall time.
+    pub fn seconds(&self) -> f64 {
+        self.gpu.unwrap_or(self.wall)
+    }
+}
+
+/// A sample pass recorded band by band (the viewer bounds its frame time this way): its samples per pixel and the
+/// first row not yet recorded.
+#[derive(Clone, Copy, Debug)]
+struct PassInFlight {
+    spp: u32,
+    next_row: u32,
+}
+
+/// A progressive renderer of one scene with one set of settings (change either → reset).
+///
+/// Samples advance one way only: `record_band` (or `record`, a whole-film band) records a pass of `spp` samples
+/// per pixel, and `samples()` grows by `spp` when the pass has covered every row. `render` and `render_timed`
+/// are loops over `record` for headless callers.
 pub struct Renderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: std::collections::HashMap<PipelineKey, wgpu::ComputePipeline>,
+    pipelines: PipelineCache,
     /// The scene's features (what a specialised pipeline compiles in).
-    pub features: Features,
+    features: Features,
     /// Whether pipelines are specialised to the settings (headless) or read them at run time (viewer).
-    pub specialize: bool,
+    specialize: bool,
     scene_group: wgpu::BindGroup,
     frame_group: wgpu::BindGroup,
     params_buffer: wgpu::Buffer,
     accum: wgpu::Buffer,
     counters: wgpu::Buffer,
-    /// Settings in force.
-    pub settings: Settings,
-    /// Camera in force.
-    pub camera: Camera,
-    /// Samples per pixel accumulated since the last reset.
-    pub samples: u32,
+    settings: Settings,
+    camera: Camera,
+    /// Samples per pixel of the complete passes since the last reset.
+    samples: u32,
+    /// The pass being recorded band by band, if one is.
+    pass: Option<PassInFlight>,
+    /// The film rows every pass covers (all by default; `set_row_window`).
+    window: std::ops::Range<u32>,
     /// Target count of the fixed-count samplers (`FrameParams::sampler_spp`; see `samplers::check_spp`).
-    pub sampler_spp: u32,
-    /// Samples per pixel per dispatch instead of `max_dispatch_spp`'s safe default: only for scenes so simple
-    /// that a sample's loops are short (check the film's sample counts: the driver drops what its budget cuts).
-    pub dispatch_spp: Option<u32>,
+    sampler_spp: u32,
+    /// Samples per pixel per dispatch instead of `max_dispatch_spp`'s safe default.
+    dispatch_spp: Option<u32>,
     /// Non-finite samples since the last reset (device counter, summed on the host).
-    pub nonfinite_total: u64,
+    nonfinite_total: u64,
     /// Rays traced since the last reset.
-    pub rays_total: u64,
+    rays_total: u64,
     env_light: u32,
     env_size: (u32, u32),
     env_constant: [f32; 3],
@@ -203,11 +241,12 @@ impl Renderer {
             ],
         });
         let d = &scene.data;
+        let film_height = settings.height;
         let mut r = Renderer {
             device,
             queue: ctx.queue.clone(),
             pipeline_layout,
-            pipelines: Default::default(),
+            pipelines: PipelineCache::default(),
             features: Features::of(d),
             specialize: true,
             scene_group,
@@ -218,6 +257,8 @@ impl Renderer {
             settings,
             camera,
             samples: 0,
+            pass: None,
+            window: 0..film_height,
             sampler_spp: crate::samplers::DEFAULT_SAMPLER_SPP,
             dispatch_spp: None,
             nonfinite_total: 0,
@@ -244,13 +285,18 @@ impl Renderer {
 
     /// Whether the pipeline for `key` is built.
     pub fn has_pipeline(&self, key: &PipelineKey) -> bool {
-        self.pipelines.contains_key(key)
+        self.pipelines.contains(key)
     }
 
     /// Adds a pipeline built elsewhere with a layout equal to `pipeline_layout()` (wgpu deduplicates
     /// equal bind group layouts, so renderers of scenes with the same bindings can share pipelines).
     pub fn insert_pipeline(&mut self, key: PipelineKey, pipeline: wgpu::ComputePipeline) {
         self.pipelines.insert(key, pipeline);
+    }
+
+    /// The pipeline built for `key`, to share with another renderer (`insert_pipeline`).
+    pub fn pipeline(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
+        self.pipelines.get(key)
     }
 
     /// The pipeline key the current settings need.
@@ -277,24 +323,18 @@ impl Renderer {
     pub fn set_baked_source(&mut self, source: &str) {
         if self.source != source {
             self.source = source.to_string();
-            self.pipelines.retain(|k, _| k.features.baked == 0);
+            self.pipelines.retain(|k| k.features.baked == 0);
         }
     }
 
     /// Builds (or finds in the cache) the pipeline for the current settings.
     pub fn prepare(&mut self) -> Result<(), String> {
         let key = self.key();
-        if !self.pipelines.contains_key(&key) {
-            let p = shaders::compute_pipeline(
-                &self.device,
-                "render",
-                self.source_for(&key),
-                "render_main",
-                &key.constants(),
-                Some(&self.pipeline_layout),
-            )?;
-            self.pipelines.insert(key, p);
-        }
+        let (device, layout) = (&self.device, &self.pipeline_layout);
+        let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
+        self.pipelines.get_or_build(key, || {
+            shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
+        })?;
         Ok(())
     }
 
@@ -305,37 +345,123 @@ impl Renderer {
         self.prepare()
     }
 
+    /// Points a warm-up renderer (one that runs other scenes' pipelines once, so that the driver compiles them
+    /// ahead of use) at pipeline `key` with `settings` (its film size kept). False when this renderer cannot run
+    /// `key` with those settings.
+    pub fn aim_at(&mut self, key: PipelineKey, settings: Settings) -> bool {
+        self.features = key.features;
+        self.settings = Settings { width: self.settings.width, height: self.settings.height, ..settings };
+        self.specialize = key.fixed.is_some();
+        self.key() == key
+    }
+
     /// Runs a zero-sample dispatch: drivers such as lavapipe compile the pipeline at its first use
     /// (seconds for the render kernel), and that belongs to start-up, not to the render time.
     pub fn warm_up(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
-        let samples = self.samples;
         let mut enc = self.device.create_command_encoder(&Default::default());
-        self.encode(&mut enc, 0);
+        self.record_warm_up(&mut enc);
         self.queue.submit([enc.finish()]);
-        self.samples = samples;
         ctx.wait()
     }
 
-    /// Forgets every accumulated sample (the next dispatch starts from sample 0).
+    /// Records a zero-sample dispatch of the current pipeline (see `warm_up`); the caller submits and waits.
+    pub fn record_warm_up(&mut self, enc: &mut wgpu::CommandEncoder) {
+        self.dispatch(enc, 0, 0, self.settings.height, None);
+    }
+
+    /// Forgets every accumulated sample (the next pass starts from sample 0).
     pub fn reset(&mut self) {
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.accum, 0, None);
         enc.clear_buffer(&self.counters, 0, None);
         self.queue.submit([enc.finish()]);
         self.samples = 0;
+        self.pass = None;
         self.nonfinite_total = 0;
         self.rays_total = 0;
     }
 
-    /// Changes settings (film size excluded) and resets.
+    /// Changes settings (film size excluded), resets and builds the pipeline they need.
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), String> {
+        self.configure(settings)?;
+        self.prepare()
+    }
+
+    /// Changes settings (film size excluded) and resets, without building a pipeline (the viewer's compile worker
+    /// builds them on another thread).
+    pub fn configure(&mut self, settings: Settings) -> Result<(), String> {
         settings.validate()?;
         if settings.width != self.settings.width || settings.height != self.settings.height {
             return Err("the film size cannot change on an existing renderer".into());
         }
         self.settings = settings;
         self.reset();
-        self.prepare()
+        Ok(())
+    }
+
+    /// Moves the camera and resets.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+        self.reset();
+    }
+
+    /// Settings in force.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Camera in force.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The scene's features (what a specialised pipeline compiles in).
+    pub fn features(&self) -> Features {
+        self.features
+    }
+
+    /// Whether pipelines are specialised to the settings.
+    pub fn is_specialized(&self) -> bool {
+        self.specialize
+    }
+
+    /// Samples per pixel accumulated in every pixel since the last reset (complete passes).
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// The first row of the pass being recorded band by band not yet recorded (0 when no pass is in flight).
+    pub fn pass_row(&self) -> u32 {
+        self.pass.map_or(0, |p| p.next_row)
+    }
+
+    /// Samples per pixel of the pass in flight, if one is.
+    pub fn pass_spp(&self) -> Option<u32> {
+        self.pass.map(|p| p.spp)
+    }
+
+    /// Non-finite samples since the last reset (counted on the device, kept out of the image).
+    pub fn nonfinite_total(&self) -> u64 {
+        self.nonfinite_total
+    }
+
+    /// Rays traced since the last reset.
+    pub fn rays_total(&self) -> u64 {
+        self.rays_total
+    }
+
+    /// Sets the fixed-count samplers' target count (`samplers::check_spp`); a change resets (the points differ).
+    pub fn set_sampler_spp(&mut self, n: u32) {
+        if n != self.sampler_spp {
+            self.sampler_spp = n;
+            self.reset();
+        }
+    }
+
+    /// Samples per pixel per dispatch instead of `max_dispatch_spp`'s safe default: only for scenes so simple
+    /// that a sample's loops are short (check the film's sample counts: the driver drops what its budget cuts).
+    pub fn set_dispatch_spp(&mut self, n: Option<u32>) {
+        self.dispatch_spp = n.map(|n| n.max(1));
     }
 
     /// The frame parameters of a dispatch of `spp` samples starting at the current sample count.
@@ -384,18 +510,51 @@ impl Renderer {
         }
     }
 
-    /// Records one dispatch of `spp` samples per pixel into `enc` and advances the sample count.
-    /// The parameters are written to the queue first, so call `submit` before recording another.
-    pub fn encode(&mut self, enc: &mut wgpu::CommandEncoder, spp: u32) {
-        self.encode_rows(enc, spp, 0, self.settings.height, None);
-        self.samples += spp;
+    /// Restricts every pass to film rows `rows` (the others stay empty: a test that needs a few rows of a big
+    /// film renders only those) and resets.
+    pub fn set_row_window(&mut self, rows: std::ops::Range<u32>) {
+        let h = self.settings.height;
+        self.window = rows.start.min(h)..rows.end.clamp(rows.start.min(h), h);
+        self.reset();
     }
 
-    /// Records a dispatch of `spp` samples per pixel for film rows `row_offset .. row_offset + row_count`
-    /// only, starting at sample index `samples`, WITHOUT advancing `samples`: the caller adds `spp` once
-    /// every row has had them (the viewer renders a pass in bands of rows to bound its frame time).
-    /// `timestamps`, when given, brackets the pass with GPU timestamps. Call `submit` before recording another.
-    pub fn encode_rows(
+    /// Records a whole pass (every row of the window) of `spp` samples per pixel into `enc` (see `record_band`).
+    pub fn record(&mut self, enc: &mut wgpu::CommandEncoder, spp: u32, timer: Option<&mut GpuTimer>) {
+        let rows = self.settings.height;
+        let done = self.record_band(enc, spp, rows, timer);
+        debug_assert!(done, "a whole-film band completes its pass");
+    }
+
+    /// Records the next `rows` rows of a pass of `spp` samples per pixel into `enc`, after the rows recorded
+    /// before (a pass started with one `spp` keeps it until it is complete). Returns whether this band completed
+    /// the pass: then `samples()` has grown by `spp`. `timer` times the dispatch. The frame parameters go to the
+    /// queue at once, so submit `enc` before recording the next band.
+    pub fn record_band(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        spp: u32,
+        rows: u32,
+        timer: Option<&mut GpuTimer>,
+    ) -> bool {
+        let end = self.window.end;
+        let pass = self.pass.unwrap_or(PassInFlight { spp, next_row: self.window.start });
+        let rows = rows.min(end - pass.next_row);
+        let writes = timer.and_then(|t| t.pass());
+        self.dispatch(enc, pass.spp, pass.next_row, rows, writes);
+        let next_row = pass.next_row + rows;
+        if next_row >= end {
+            self.pass = None;
+            self.samples += pass.spp;
+            true
+        } else {
+            self.pass = Some(PassInFlight { next_row, ..pass });
+            false
+        }
+    }
+
+    /// One dispatch of `spp` samples per pixel, starting at sample index `samples`, over film rows
+    /// `row_offset .. row_offset + row_count`.
+    fn dispatch(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
         spp: u32,
@@ -403,36 +562,78 @@ impl Renderer {
         row_count: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let row_offset = row_offset.min(self.settings.height);
-        let row_count = row_count.min(self.settings.height - row_offset);
         let p = GpuFrameParams { row_offset, row_count, ..self.frame_params(spp) };
         self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
         let mut pass = enc
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: timestamps });
-        let pipeline = self.pipelines.get(&self.key()).expect("prepare() builds the pipeline before encoding");
+        let pipeline = self.pipelines.get(&self.key()).expect("prepare() builds the pipeline before recording");
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.scene_group, &[]);
         pass.set_bind_group(1, &self.frame_group, &[]);
         pass.dispatch_workgroups(self.settings.width.div_ceil(8), row_count.div_ceil(8), 1);
     }
 
-    /// Renders `spp` more samples per pixel in one submission and waits for them (with the device timeout).
-    pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), GpuError> {
+    /// Renders `spp` more samples per pixel and waits for them (with the device timeout): dispatches of at most
+    /// `max_dispatch_spp()` samples, one submission each, one wait at the end.
+    pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), String> {
+        self.prepare()?;
         // lavapipe (Mesa 22.3) gives each invocation one budget of 65535 loop iterations shared by all
         // its loops and silently stops looping when it is spent: a 1024-spp dispatch accumulated only
         // ~300-450 samples. Split into small dispatches (one submit each, so each sees its own
         // parameters) and wait once at the end.
         let chunk = self.max_dispatch_spp();
+        let pixels = self.settings.width as u64 * self.window.len() as u64;
+        let mut in_flight = 0u64;
         let mut left = spp;
         while left > 0 {
             let n = left.min(chunk);
             let mut enc = self.device.create_command_encoder(&Default::default());
-            self.encode(&mut enc, n);
+            self.record(&mut enc, n, None);
             self.queue.submit([enc.finish()]);
             left -= n;
+            in_flight += n as u64 * pixels;
+            if in_flight >= PIXEL_SAMPLES_PER_WAIT || left == 0 {
+                ctx.wait().map_err(|e| e.to_string())?;
+                self.collect_counters(ctx).map_err(|e| e.to_string())?;
+                in_flight = 0;
+            }
         }
-        ctx.wait()?;
-        self.collect_counters(ctx)
+        Ok(())
+    }
+
+    /// Renders `spp` more samples per pixel like `render`, but waits after every dispatch and times each with
+    /// `timer` (GPU time) and the wall clock, for benchmarks.
+    pub fn render_timed(
+        &mut self,
+        ctx: &GpuContext,
+        spp: u32,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<Timing, String> {
+        self.prepare()?;
+        let mut timing = Timing { gpu: timer.as_ref().map(|_| 0.0), ..Timing::default() };
+        let rays_before = self.rays_total;
+        let chunk = self.max_dispatch_spp();
+        let mut left = spp;
+        while left > 0 {
+            let n = left.min(chunk);
+            let t0 = Instant::now();
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            self.record(&mut enc, n, timer.as_deref_mut());
+            self.queue.submit([enc.finish()]);
+            ctx.wait().map_err(|e| e.to_string())?;
+            timing.wall += t0.elapsed().as_secs_f64();
+            left -= n;
+            let full = timer.as_ref().is_some_and(|t| t.is_full());
+            if full || left == 0 {
+                if let (Some(t), Some(g)) = (timer.as_deref_mut(), timing.gpu.as_mut()) {
+                    *g += t.read(ctx).map_err(|e| e.to_string())?.iter().sum::<f64>();
+                }
+                // Also bounds the device's 32-bit ray counter between readbacks.
+                self.collect_counters(ctx).map_err(|e| e.to_string())?;
+            }
+        }
+        timing.rays = self.rays_total - rays_before;
+        Ok(timing)
     }
 
     /// Most samples per pixel one dispatch may take without exhausting a driver's per-invocation loop
@@ -448,11 +649,6 @@ impl Renderer {
         } else {
             16
         }
-    }
-
-    /// The pipeline built for `key`, to share with another renderer (`insert_pipeline`).
-    pub fn pipeline(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
-        self.pipelines.get(key)
     }
 
     /// Adds the device counters to the host totals and clears them (u32 on the device would overflow).

@@ -130,36 +130,19 @@ impl Bench {
     fn render_rows(&mut self, settings: &Settings, spp: u32, rows: (u32, u32)) -> Film {
         let s = Settings { width: self.width, height: self.height, ..settings.clone() };
         self.renderer.set_settings(s).expect("settings");
-        let chunk = (65536 / (self.width * rows.1)).clamp(1, 64);
-        let mut left = spp;
-        while left > 0 {
-            let n = left.min(chunk);
-            let mut enc = ctx().device.create_command_encoder(&Default::default());
-            self.renderer.encode_rows(&mut enc, n, rows.0, rows.1, None);
-            ctx().queue.submit([enc.finish()]);
-            ctx().wait().expect("render");
-            self.renderer.samples += n;
-            left -= n;
-        }
-        self.renderer.collect_counters(ctx()).expect("counters");
+        self.renderer.set_row_window(rows.0..rows.0 + rows.1);
+        self.renderer.render(ctx(), spp).expect("render");
         let film = self.renderer.film(ctx()).expect("readback");
-        assert_eq!(film.nonfinite_total, 0, "NaN/Inf samples with {:?}", self.renderer.settings);
+        self.renderer.set_row_window(0..self.height);
+        assert_eq!(film.nonfinite_total, 0, "NaN/Inf samples with {:?}", self.renderer.settings());
         film
     }
 
     /// Adds `spp` samples per pixel to the current accumulation and reads the film.
     fn more(&mut self, spp: u32) -> Film {
-        // About 2^16 samples per submission: short dispatches, few submissions.
-        let per_pixel = self.width * self.height;
-        let chunk = (65536 / per_pixel).clamp(1, 64);
-        let mut left = spp;
-        while left > 0 {
-            let n = left.min(chunk);
-            self.renderer.render(ctx(), n).expect("render");
-            left -= n;
-        }
+        self.renderer.render(ctx(), spp).expect("render");
         let film = self.renderer.film(ctx()).expect("readback");
-        assert_eq!(film.nonfinite_total, 0, "NaN/Inf samples with {:?}", self.renderer.settings);
+        assert_eq!(film.nonfinite_total, 0, "NaN/Inf samples with {:?}", self.renderer.settings());
         film
     }
 }

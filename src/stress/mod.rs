@@ -119,19 +119,12 @@ fn run_case(
         pipelines.insert(key, p.clone());
     }
     r.warm_up(ctx).map_err(|e| e.to_string())?;
-    r.dispatch_spp = c.dispatch_spp;
+    r.set_dispatch_spp(c.dispatch_spp);
     let t = Instant::now();
-    // Submit in slices so a driver timeout never sees one huge batch.
-    let slice = r.max_dispatch_spp().saturating_mul(64).max(1);
-    let mut left = c.spp;
-    while left > 0 {
-        let n = left.min(slice);
-        r.render(ctx, n).map_err(|e| format!("{}: {e}", c.name))?;
-        left -= n;
-    }
+    r.render(ctx, c.spp).map_err(|e| format!("{}: {e}", c.name))?;
     let seconds = t.elapsed().as_secs_f64();
     let film = r.film(ctx).map_err(|e| format!("{}: {e}", c.name))?;
-    Ok(judge(c, &film, r.nonfinite_total, seconds, means))
+    Ok(judge(c, &film, r.nonfinite_total(), seconds, means))
 }
 
 /// Image mean and its standard error (from the per-pixel sample variances).

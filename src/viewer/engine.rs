@@ -12,6 +12,8 @@ use crate::features::PipelineKey;
 use crate::film::Tonemap;
 use crate::gpu::{GpuContext, GpuError};
 use crate::gpu_scene::{GpuScene, SceneData};
+use crate::gpu_timer::GpuTimer;
+use crate::pipeline_cache::PipelineCache;
 use crate::render::Renderer;
 use crate::scene::{self, Camera, Environment, LoadOptions, Scene};
 use crate::settings::{Settings, Strategy};
@@ -390,11 +392,8 @@ fn compile_worker(
         }
         let t = Instant::now();
         if let Some((c, _, r)) = warm.as_mut() {
-            r.features = job.key.features;
-            r.settings = Settings { width: 8, height: 8, ..job.settings.clone() };
-            r.specialize = job.key.fixed.is_some();
             r.set_baked_source(&job.source);
-            if r.key() == job.key {
+            if r.aim_at(job.key, job.settings.clone()) {
                 let _ = r.prepare().and_then(|_| r.warm_up(c).map_err(|e| e.to_string()));
             }
         }
@@ -412,9 +411,6 @@ struct SideState {
     renderer: Renderer,
     preview: Renderer,
     preview_done: bool,
-    /// Next row of the pass in progress, and its samples per pixel.
-    pass_row: u32,
-    pass_spp: u32,
     /// Seconds per pixel sample, per pipeline kind (0 generic, 1 specialised).
     est: [f64; 2],
     /// GPU seconds of full-resolution dispatches since the restart.
@@ -441,8 +437,6 @@ impl SideState {
             renderer,
             preview,
             preview_done: false,
-            pass_row: 0,
-            pass_spp: 1,
             // Conservative guesses (lavapipe, 2 cores) until the first dispatch is timed.
             est: [1.0 / 0.1e6, 1.0 / 0.2e6],
             render_seconds: 0.0,
@@ -459,33 +453,33 @@ impl SideState {
         self.renderer.reset();
         self.preview.reset();
         self.preview_done = false;
-        self.pass_row = 0;
-        self.pass_spp = 1;
         self.render_seconds = 0.0;
         self.pixel_samples = 0.0;
         self.generation += 1;
         self.restarted_at = Some(Instant::now());
     }
 
-    fn set_settings(&mut self, s: Settings) {
-        let (w, h) = (self.renderer.settings.width, self.renderer.settings.height);
-        let (pw, ph) = (self.preview.settings.width, self.preview.settings.height);
-        self.renderer.settings = Settings { width: w, height: h, ..s.clone() };
-        self.preview.settings = Settings { width: pw, height: ph, ..s };
+    fn set_settings(&mut self, s: Settings) -> Result<(), String> {
+        let (w, h) = (self.renderer.settings().width, self.renderer.settings().height);
+        let (pw, ph) = (self.preview.settings().width, self.preview.settings().height);
+        self.renderer.configure(Settings { width: w, height: h, ..s.clone() })?;
+        self.preview.configure(Settings { width: pw, height: ph, ..s })?;
         self.restart();
+        Ok(())
     }
 
     fn set_camera(&mut self, c: Camera) {
-        self.renderer.camera = c.clone();
-        self.preview.camera = c;
+        self.renderer.set_camera(c.clone());
+        self.preview.set_camera(c);
         self.restart();
     }
 
     /// Rows and samples per pixel of the next full-resolution dispatch for a budget of `budget` seconds.
     fn plan(&self, budget: f64) -> (u32, u32) {
-        let (w, h) = (self.renderer.settings.width, self.renderer.settings.height);
+        let (w, h) = (self.renderer.settings().width, self.renderer.settings().height);
         let est = self.est[(self.pipeline == PipelineState::Specialised) as usize];
-        if self.pass_row == 0 {
+        let pass_row = self.renderer.pass_row();
+        if pass_row == 0 {
             let full = est * (w as f64) * (h as f64);
             if full <= budget {
                 let spp = ((budget / full).floor() as u32).clamp(1, 64);
@@ -493,7 +487,7 @@ impl SideState {
             }
         }
         let rows = (budget / (est * w as f64)).floor() as u32;
-        let rows = (rows / 8 * 8).max(8).min(h - self.pass_row);
+        let rows = (rows / 8 * 8).max(8).min(h - pass_row);
         (rows, 1)
     }
 }
@@ -502,13 +496,6 @@ impl SideState {
 enum Dispatch {
     Preview,
     Band { row0: u32, rows: u32, spp: u32 },
-}
-
-struct Timestamps {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    staging: wgpu::Buffer,
-    period_ns: f64,
 }
 
 struct Engine {
@@ -521,12 +508,12 @@ struct Engine {
     display: DisplayPass,
     options: DisplayOptions,
     reference: Option<wgpu::Buffer>,
-    pipelines: HashMap<PipelineKey, wgpu::ComputePipeline>,
+    pipelines: PipelineCache,
     requested: HashSet<PipelineKey>,
     jobs: Sender<CompileJob>,
     compiled: Receiver<(PipelineKey, Result<wgpu::ComputePipeline, String>, f64)>,
     worker_stop: Arc<AtomicBool>,
-    timestamps: Option<Timestamps>,
+    timer: Option<GpuTimer>,
     shared: Arc<Mutex<Shared>>,
     repaint: Arc<dyn Fn() + Send + Sync>,
     lost: Arc<AtomicBool>,
@@ -602,7 +589,8 @@ impl Engine {
         let lost = Arc::new(AtomicBool::new(false));
         let gpu_error = Arc::new(Mutex::new(None));
         Self::watch_device(&ctx, &lost, &gpu_error);
-        let timestamps = Self::make_timestamps(&ctx);
+        // A pass per side and the display pass per frame.
+        let timer = GpuTimer::new(&ctx, 3);
         let (warm_scene, warm) = Self::warm_renderer(&ctx)?;
         {
             let mut s = shared.lock().unwrap_or_else(|p| p.into_inner());
@@ -622,12 +610,12 @@ impl Engine {
             display,
             options: config.display,
             reference: None,
-            pipelines: HashMap::new(),
+            pipelines: PipelineCache::default(),
             requested: HashSet::new(),
             jobs,
             compiled,
             worker_stop,
-            timestamps,
+            timer,
             shared,
             repaint,
             lost,
@@ -701,30 +689,6 @@ impl Engine {
         }));
     }
 
-    fn make_timestamps(ctx: &GpuContext) -> Option<Timestamps> {
-        if !ctx.timestamps {
-            return None;
-        }
-        let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("viewer timestamps"),
-            ty: wgpu::QueryType::Timestamp,
-            count: 6,
-        });
-        let resolve = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps resolve"),
-            size: 48,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps staging"),
-            size: 48,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        Some(Timestamps { set, resolve, staging, period_ns: ctx.queue.get_timestamp_period() as f64 })
-    }
-
     fn active(&self) -> usize {
         if self.compare {
             2
@@ -745,7 +709,7 @@ impl Engine {
 
     fn request(&mut self, key: PipelineKey, settings: &Settings, priority: u32) {
         self.update_wanted();
-        if self.pipelines.contains_key(&key) || !self.requested.insert(key) {
+        if self.pipelines.contains(&key) || !self.requested.insert(key) {
             return;
         }
         self.job_settings.insert(key, settings.clone());
@@ -771,11 +735,11 @@ impl Engine {
     /// The specialised pipelines a side needs now (first) and after a strategy toggle (the lecture's
     /// main comparison): built ahead so that such a toggle shows its first image at once.
     fn neighbours(side: &SideState) -> Vec<(PipelineKey, Settings)> {
-        let s = &side.renderer.settings;
-        let mut v = vec![(PipelineKey::specialized(side.renderer.features, s), s.clone())];
+        let s = side.renderer.settings();
+        let mut v = vec![(PipelineKey::specialized(side.renderer.features(), s), s.clone())];
         for st in Strategy::ALL {
             let n = Settings { strategy: *st, ..s.clone() };
-            let k = PipelineKey::specialized(side.renderer.features, &n);
+            let k = PipelineKey::specialized(side.renderer.features(), &n);
             if !v.iter().any(|(x, _)| *x == k) {
                 v.push((k, n));
             }
@@ -791,7 +755,7 @@ impl Engine {
             }
         }
         if self.generic {
-            let s = self.sides[0].renderer.settings.clone();
+            let s = self.sides[0].renderer.settings().clone();
             self.request(PipelineKey::generic(), &s, PRIORITY_GENERIC);
         }
     }
@@ -833,15 +797,12 @@ impl Engine {
     fn warm_up(&mut self, key: PipelineKey, p: &wgpu::ComputePipeline) -> Result<(), String> {
         let settings = self.job_settings.get(&key).cloned().unwrap_or_default();
         let w = &mut self.warm;
-        w.features = key.features;
-        w.settings = Settings { width: 8, height: 8, ..settings };
-        w.specialize = key.fixed.is_some();
-        if w.key() != key {
+        if !w.aim_at(key, settings) {
             return Ok(());
         }
         w.insert_pipeline(key, p.clone());
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        w.encode_rows(&mut enc, 0, 0, 8, None);
+        w.record_warm_up(&mut enc);
         self.ctx.queue.submit([enc.finish()]);
         self.ctx
             .device
@@ -853,27 +814,31 @@ impl Engine {
     /// Chooses the pipeline of side `i` (specialised if built, else generic if built) and hands it to
     /// its renderers. False when neither is ready.
     fn choose_pipeline(&mut self, i: usize) -> bool {
-        let spec = PipelineKey::specialized(self.sides[i].renderer.features, &self.sides[i].renderer.settings);
+        let spec = PipelineKey::specialized(self.sides[i].renderer.features(), self.sides[i].renderer.settings());
         let generic = PipelineKey::generic();
-        let s = self.sides[i].renderer.settings.clone();
-        let (key, state) = if self.pipelines.contains_key(&spec) {
+        let s = self.sides[i].renderer.settings().clone();
+        let (key, state) = if self.pipelines.contains(&spec) {
             (spec, PipelineState::Specialised)
         } else {
             self.request(spec, &s, PRIORITY_NOW);
-            if self.pipelines.contains_key(&generic) {
+            if self.pipelines.contains(&generic) {
                 (generic, PipelineState::Generic)
             } else {
                 self.sides[i].pipeline = PipelineState::Compiling;
                 return false;
             }
         };
-        let p = self.pipelines[&key].clone();
+        let p = self.pipelines.get(&key).expect("checked above").clone();
         let side = &mut self.sides[i];
         side.pipeline = state;
         for r in [&mut side.renderer, &mut side.preview] {
-            r.specialize = state == PipelineState::Specialised;
             if !r.has_pipeline(&key) {
                 r.insert_pipeline(key, p.clone());
+            }
+            // The pipeline is in the renderer's cache now: this only selects it.
+            if let Err(e) = r.set_specialize(state == PipelineState::Specialised) {
+                log::error!("selecting a built pipeline: {e}");
+                return false;
             }
         }
         true
@@ -890,7 +855,7 @@ impl Engine {
                     == Settings { exposure: 0.0, width: 0, height: 0, ..s.clone() };
                 self.settings[i] = s.clone();
                 if !same_estimator {
-                    self.sides[i].set_settings(s);
+                    self.sides[i].set_settings(s)?;
                     if i < self.active() {
                         self.request_pipelines();
                     }
@@ -1133,7 +1098,7 @@ impl Engine {
                 Self::start_worker(&ctx, &sides[0].renderer, self.warm_device, self.wanted.clone());
             let lost = Arc::new(AtomicBool::new(false));
             Self::watch_device(&ctx, &lost, &self.gpu_error);
-            self.timestamps = Self::make_timestamps(&ctx);
+            self.timer = GpuTimer::new(&ctx, 3);
             let (warm_scene, warm) = Self::warm_renderer(&ctx)?;
             self.warm_scene = warm_scene;
             self.warm = warm;
@@ -1184,24 +1149,17 @@ impl Engine {
             if !self.choose_pipeline(i) {
                 continue;
             }
-            let ts = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
-                query_set: &t.set,
-                beginning_of_pass_write_index: Some(2 * i as u32),
-                end_of_pass_write_index: Some(2 * i as u32 + 1),
-            });
             let side = &mut self.sides[i];
+            let timer = self.timer.as_mut();
             if !side.preview_done {
-                let ph = side.preview.settings.height;
-                side.preview.encode_rows(&mut enc, 1, 0, ph, ts);
+                side.preview.record(&mut enc, 1, timer);
                 dispatches.push((i, Dispatch::Preview));
-            } else if side.renderer.samples < MAX_SPP {
+            } else if side.renderer.samples() < MAX_SPP {
                 let (rows, spp) = side.plan(budget);
-                if side.pass_row == 0 {
-                    side.pass_spp = spp;
-                }
-                let spp = side.pass_spp;
-                side.renderer.encode_rows(&mut enc, spp, side.pass_row, rows, ts);
-                dispatches.push((i, Dispatch::Band { row0: side.pass_row, rows, spp }));
+                let row0 = side.renderer.pass_row();
+                let spp = side.renderer.pass_spp().unwrap_or(spp);
+                side.renderer.record_band(&mut enc, spp, rows, timer);
+                dispatches.push((i, Dispatch::Band { row0, rows, spp }));
             }
         }
         if dispatches.is_empty() && self.frames > 0 && !self.display_dirty() {
@@ -1223,8 +1181,8 @@ impl Engine {
             compare: self.compare as u32,
             has_reference: self.reference.is_some() as u32,
             preview_scale: PREVIEW_SCALE,
-            preview_width: self.sides[0].preview.settings.width,
-            preview_height: self.sides[0].preview.settings.height,
+            preview_width: self.sides[0].preview.settings().width,
+            preview_height: self.sides[0].preview.settings().height,
             log_min: self.options.log_range[0],
             log_max: self.options.log_range[1],
             row_offset: 0,
@@ -1257,35 +1215,29 @@ impl Engine {
         if stats {
             self.last_stats = Instant::now();
         }
-        let ts = self.timestamps.as_ref().map(|t| wgpu::ComputePassTimestampWrites {
-            query_set: &t.set,
-            beginning_of_pass_write_index: Some(4),
-            end_of_pass_write_index: Some(5),
-        });
+        let ts = self.timer.as_mut().and_then(|t| t.pass());
         let inputs = DisplayInputs {
             accum: [self.sides[0].renderer.accum_buffer(), self.sides[b].renderer.accum_buffer()],
             preview: [self.sides[0].preview.accum_buffer(), self.sides[b].preview.accum_buffer()],
             reference: self.reference.as_ref(),
         };
         self.display.encode(&mut enc, &params, &inputs, stats, ts);
-        if let Some(t) = &self.timestamps {
-            enc.resolve_query_set(&t.set, 0..6, &t.resolve, 0);
-            enc.copy_buffer_to_buffer(&t.resolve, 0, &t.staging, 0, 48);
-        }
         let t0 = Instant::now();
         self.ctx.queue.submit([enc.finish()]);
         let out = self.display.read(&self.ctx, stats)?;
         let wall = t0.elapsed().as_secs_f64();
-        let stamps = match &self.timestamps {
-            Some(t) => Some(read_timestamps(&self.ctx, t)?),
+        // Seconds of this frame's passes in the order they were recorded: the dispatches, then the display pass.
+        let stamps = match self.timer.as_mut() {
+            Some(t) => Some(t.read(&self.ctx)?),
             None => None,
         };
+        let display_ms = stamps.as_ref().and_then(|s| s.last()).map_or(0.0, |s| s * 1e3);
         // Book-keeping: advance the passes, time the dispatches, update the cost estimates.
         let work: f64 = dispatches.iter().map(|(i, d)| self.dispatch_pixels(*i, d)).sum::<f64>().max(1.0);
-        for (i, d) in &dispatches {
+        for (k, (i, d)) in dispatches.iter().enumerate() {
             let pixels = self.dispatch_pixels(*i, d);
             let secs = match &stamps {
-                Some(s) => (s[2 * i + 1].saturating_sub(s[2 * i]) as f64) * 1e-9,
+                Some(s) => s[k],
                 None => wall * pixels / work,
             };
             let side = &mut self.sides[*i];
@@ -1297,27 +1249,21 @@ impl Engine {
             side.last_gpu_ms = secs * 1e3;
             match d {
                 Dispatch::Preview => {
-                    side.preview.samples += 1;
                     side.preview_done = true;
                     if let Some(t) = side.restarted_at.take() {
                         log::info!(
                             "side {i}: first image {:.0} ms after the restart (preview {:.1} GPU ms, display {:.1} GPU ms, submit to readback {:.1} ms, {:?} pipeline)",
                             t.elapsed().as_secs_f64() * 1e3,
                             secs * 1e3,
-                            stamps.map(|s| (s[5].saturating_sub(s[4]) as f64) * 1e-6).unwrap_or(0.0),
+                            display_ms,
                             wall * 1e3,
                             side.pipeline
                         );
                     }
                 }
-                Dispatch::Band { rows, spp, .. } => {
+                Dispatch::Band { .. } => {
                     side.render_seconds += secs;
                     side.pixel_samples += pixels;
-                    side.pass_row += rows;
-                    if side.pass_row >= side.renderer.settings.height {
-                        side.pass_row = 0;
-                        side.renderer.samples += spp;
-                    }
                 }
             }
         }
@@ -1327,7 +1273,6 @@ impl Engine {
             }
         }
         self.frames += 1;
-        let display_ms = stamps.map(|s| (s[5].saturating_sub(s[4]) as f64) * 1e-6).unwrap_or(0.0);
         let frame = Frame {
             width: w,
             height: h,
@@ -1357,8 +1302,8 @@ impl Engine {
     fn dispatch_pixels(&self, i: usize, d: &Dispatch) -> f64 {
         let s = &self.sides[i];
         match d {
-            Dispatch::Preview => (s.preview.settings.width * s.preview.settings.height) as f64,
-            Dispatch::Band { rows, spp, .. } => (s.renderer.settings.width * rows * spp) as f64,
+            Dispatch::Preview => (s.preview.settings().width * s.preview.settings().height) as f64,
+            Dispatch::Band { rows, spp, .. } => (s.renderer.settings().width * rows * spp) as f64,
         }
     }
 
@@ -1371,17 +1316,17 @@ impl Engine {
             stats[i] = SideStats {
                 settings: self.settings[i].clone(),
                 generation: side.generation,
-                spp: r.samples,
-                pass_rows: side.pass_row,
+                spp: r.samples(),
+                pass_rows: r.pass_row(),
                 samples_per_s: if side.render_seconds > 0.0 { side.pixel_samples / side.render_seconds } else { 0.0 },
                 mrays_per_s: if side.render_seconds > 0.0 {
-                    r.rays_total as f64 / side.render_seconds / 1e6
+                    r.rays_total() as f64 / side.render_seconds / 1e6
                 } else {
                     0.0
                 },
                 gpu_ms: side.last_gpu_ms,
                 image: self.image_stats[i],
-                nonfinite_samples: r.nonfinite_total,
+                nonfinite_samples: r.nonfinite_total(),
                 pipeline: if i < n { side.pipeline } else { PipelineState::Compiling },
                 shown: side.preview_done,
             };
@@ -1392,28 +1337,4 @@ impl Engine {
         }
         (self.repaint)();
     }
-}
-
-fn read_timestamps(ctx: &GpuContext, t: &Timestamps) -> Result<[u64; 6], GpuError> {
-    let (tx, rx) = mpsc::channel();
-    t.staging.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.wait()?;
-    match rx.recv_timeout(Duration::from_secs(5)) {
-        Ok(Ok(())) => {}
-        Ok(Err(e)) => return Err(GpuError::Map(e.to_string())),
-        Err(_) => return Err(GpuError::Map("the map callback never ran".into())),
-    }
-    let v: Vec<u64> = {
-        let data = t.staging.get_mapped_range(..).map_err(|e| GpuError::Map(format!("{e:?}")))?;
-        bytemuck::pod_collect_to_vec(&data[..48])
-    };
-    t.staging.unmap();
-    let scale = t.period_ns;
-    let mut out = [0u64; 6];
-    for (o, x) in out.iter_mut().zip(v) {
-        *o = (x as f64 * scale) as u64;
-    }
-    Ok(out)
 }

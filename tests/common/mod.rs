@@ -24,12 +24,7 @@ pub fn scene(name: &str) -> Scene {
 pub fn render(ctx: &GpuContext, scene: &Scene, settings: &Settings, spp: u32) -> Film {
     let gs = GpuScene::upload(ctx, SceneData::build(scene)).expect("upload");
     let mut r = Renderer::new(ctx, &gs, scene.camera.clone(), settings.clone()).expect("renderer");
-    let mut left = spp;
-    while left > 0 {
-        let n = left.min(64);
-        r.render(ctx, n).expect("render");
-        left -= n;
-    }
+    r.render(ctx, spp).expect("render");
     r.film(ctx).expect("readback")
 }
 
