@@ -6,7 +6,7 @@ use mislab::gpu::{self, GpuContext};
 use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::progressive::{self, Budget};
 use mislab::render::Renderer;
-use mislab::scene::{self, Environment, LoadOptions};
+use mislab::scene::{self, Environment, SceneSpec};
 use mislab::settings::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -136,30 +136,10 @@ impl SettingsArgs {
     }
 }
 
-/// How the scene is chosen and modified.
-#[derive(Args, Clone)]
-struct SceneArgs {
-    /// A .gltf/.glb/.toml file or a built-in scene: veach-mis, cornell-box, furnace, area-vs-cosine.
-    #[arg(default_value = "veach-mis")]
-    scene: String,
-    /// glTF scene index (default: the file's default scene).
-    #[arg(long)]
-    gltf_scene: Option<usize>,
-    /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
-    #[arg(long)]
-    env: Option<PathBuf>,
-    /// Scale of the --env map.
-    #[arg(long, default_value_t = 1.0)]
-    env_scale: f32,
-    /// Rotation of the --env map about +Y, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    env_rotation: f32,
-}
-
 #[derive(Args, Clone)]
 struct RenderArgs {
     #[command(flatten)]
-    scene: SceneArgs,
+    scene: SceneSpec,
     /// Output file; .png (sRGB, tonemapped) or .exr (linear float32 RGB).
     #[arg(short, long, default_value = "render.png")]
     output: PathBuf,
@@ -227,32 +207,9 @@ fn gpu_context() -> Result<GpuContext, Failure> {
     GpuContext::new().map_err(|e| bad(e.to_string()))
 }
 
-/// Loads the scene named on the command line, applies --env, prints its warnings once.
-fn load_scene(args: &SceneArgs) -> Result<scene::Scene, Failure> {
-    // Loader panics are caught in scene::load; keep the default hook from printing them as crashes.
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let loaded = scene::load(&args.scene, &LoadOptions { gltf_scene: args.gltf_scene });
-    std::panic::set_hook(hook);
-    let mut scene = loaded.map_err(|e| bad(e.to_string()))?;
-    if let Some(env) = &args.env {
-        let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| bad(e.to_string()))?;
-        scene.warnings.extend(warnings);
-        scene.environment =
-            Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
-    }
-    let geometry = scene.triangle_count() + scene.spheres.len() + scene.quads.len();
-    if !scene.has_lights() && geometry > 0 {
-        scene.warnings.push("the scene has no lights and no environment: the image will be black".into());
-    }
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", args.scene);
-    }
-    if geometry == 0 && !scene.has_lights() {
-        // Nothing at all to render: an empty or broken file, not a black image.
-        return Err(bad(format!("{}: the scene is empty: no geometry, no lights and no environment", args.scene)));
-    }
-    Ok(scene)
+/// Loads the scene named on the command line (see `SceneSpec::load`).
+fn load_scene(spec: &SceneSpec) -> Result<scene::Scene, Failure> {
+    spec.load().map_err(bad)
 }
 
 /// Lights a strategy can never reach (delta lights under direction-only strategies): say so once.
@@ -404,8 +361,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
     let ctx = gpu_context()?;
     print!("chosen {}", gpu::describe(&ctx));
     if let Some(name) = scene_name {
-        let args = SceneArgs { scene: name, gltf_scene: None, env: None, env_scale: 1.0, env_rotation: 0.0 };
-        let scene = load_scene(&args)?;
+        let scene = load_scene(&SceneSpec::named(&name))?;
         let data = SceneData::build(&scene);
         println!(
             "scene {}: {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights ({} delta), environment: {}",

@@ -8,57 +8,15 @@ use crate::gpu_scene::{GpuScene, SceneData};
 use crate::gpu_timer::GpuTimer;
 use crate::progressive::{Budget, RenderStats};
 use crate::render::Renderer;
-use crate::scene::{self, Environment, LoadOptions, Scene};
+use crate::scene::{Scene, SceneSpec};
 use crate::settings::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Seed of references (distinct from the seeds 0, 1, … that `mislab bench` measures, so the reference's
 /// error is independent of theirs).
 pub const REFERENCE_SEED: u32 = 0x5eed_f00d;
-
-/// The scene and its environment override, as on the command line.
-#[derive(clap::Args, Clone, Debug)]
-pub struct SceneSpec {
-    /// A .gltf/.glb/.toml file or a built-in scene: veach-mis, cornell-box, furnace, area-vs-cosine.
-    #[arg(default_value = "veach-mis")]
-    pub scene: String,
-    /// glTF scene index (default: the file's default scene).
-    #[arg(long)]
-    pub gltf_scene: Option<usize>,
-    /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
-    #[arg(long)]
-    pub env: Option<PathBuf>,
-    /// Scale of the --env map.
-    #[arg(long, default_value_t = 1.0)]
-    pub env_scale: f32,
-    /// Rotation of the --env map about +Y, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub env_rotation: f32,
-}
-
-impl SceneSpec {
-    /// Loads the scene and applies the environment override; prints the loader's warnings.
-    pub fn load(&self) -> Result<Scene, String> {
-        let mut s =
-            scene::load(&self.scene, &LoadOptions { gltf_scene: self.gltf_scene }).map_err(|e| e.to_string())?;
-        if let Some(env) = &self.env {
-            let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| e.to_string())?;
-            s.warnings.extend(warnings);
-            s.environment = Environment::Map {
-                map: Arc::new(map),
-                scale: self.env_scale,
-                rotation: self.env_rotation.to_radians(),
-            };
-        }
-        for w in &s.warnings {
-            eprintln!("warning: {}: {w}", self.scene);
-        }
-        Ok(s)
-    }
-}
 
 /// `mislab reference` flags.
 #[derive(clap::Args, Clone, Debug)]

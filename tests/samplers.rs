@@ -663,7 +663,7 @@ fn reference_exr_records_spp_and_settings() {
     assert_eq!(film.spp(), 40);
     let dir = scratch("reference");
     let path = dir.join("ref.exr");
-    let spec = SceneSpec { scene: "veach-mis".into(), gltf_scene: None, env: None, env_scale: 1.0, env_rotation: 0.0 };
+    let spec = mislab::scene::SceneSpec::named("veach-mis");
     write_exr(&path, &film, &header_attributes(&spec, &settings, &stats)).unwrap();
     let back = read_exr(&path).unwrap();
     assert_eq!((back.width, back.height), (24, 16));

@@ -4,7 +4,10 @@
 pub mod builtin;
 pub mod envmap;
 pub mod gltf;
+pub mod spec;
 pub mod toml;
+
+pub use spec::SceneSpec;
 
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};

@@ -10,7 +10,7 @@ pub mod engine;
 
 use crate::film::Tonemap;
 use crate::gpu::GpuContext;
-use crate::scene::{self, Environment, LoadOptions, Scene};
+use crate::scene::{Scene, SceneSpec};
 use crate::settings::{Settings, Strategy};
 use app::Viewer;
 use display::View;
@@ -23,24 +23,14 @@ use std::time::{Duration, Instant};
 /// Command-line arguments of `mislab view`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ViewArgs {
-    /// A .gltf/.glb/.toml file or a built-in scene: veach-mis, cornell-box, furnace, area-vs-cosine.
-    #[arg(default_value = "veach-mis")]
-    pub scene: String,
+    #[command(flatten)]
+    pub scene: SceneSpec,
     /// Film width in pixels.
     #[arg(long, default_value_t = 512)]
     pub width: u32,
     /// Film height in pixels.
     #[arg(long, default_value_t = 512)]
     pub height: u32,
-    /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
-    #[arg(long)]
-    pub env: Option<PathBuf>,
-    /// Scale of the --env map.
-    #[arg(long, default_value_t = 1.0)]
-    pub env_scale: f32,
-    /// Rotation of the --env map about +Y, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub env_rotation: f32,
     /// A reference EXR of the film's size (for RMSE and the relmse view).
     #[arg(long)]
     pub reference: Option<PathBuf>,
@@ -99,23 +89,9 @@ impl Default for ViewArgs {
     }
 }
 
-/// Loads the scene (with --env applied), printing its warnings once.
+/// Loads the scene (see `SceneSpec::load`).
 pub fn load_scene(args: &ViewArgs) -> Result<Scene, String> {
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let loaded = scene::load(&args.scene, &LoadOptions::default());
-    std::panic::set_hook(hook);
-    let mut scene = loaded.map_err(|e| e.to_string())?;
-    if let Some(env) = &args.env {
-        let (map, warnings) = scene::envmap::load_envmap(env).map_err(|e| e.to_string())?;
-        scene.warnings.extend(warnings);
-        scene.environment =
-            Environment::Map { map: Arc::new(map), scale: args.env_scale, rotation: args.env_rotation.to_radians() };
-    }
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", args.scene);
-    }
-    Ok(scene)
+    args.scene.load()
 }
 
 /// The engine configuration and the panel's starting state for `args`.
@@ -134,7 +110,7 @@ pub fn config(args: &ViewArgs, scene: Scene) -> Result<(EngineConfig, [Settings;
     let settings = [a, b];
     let config = EngineConfig {
         scene,
-        scene_name: args.scene.clone(),
+        scene_name: args.scene.scene.clone(),
         settings: settings.clone(),
         compare: args.compare.is_some(),
         display,
@@ -154,7 +130,7 @@ pub fn start(args: &ViewArgs, repaint: Arc<dyn Fn() + Send + Sync>) -> Result<Vi
     if let Some(r) = &args.reference {
         engine.send(engine::Command::LoadReference(r.clone()));
     }
-    let mut v = Viewer::new(engine, settings, compare, display, args.scene.clone());
+    let mut v = Viewer::new(engine, settings, compare, display, args.scene.scene.clone());
     if let Some(r) = &args.reference {
         v.reference_path = r.display().to_string();
     }
@@ -355,7 +331,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     setup.instance_descriptor.backends = wgpu::Backends::VULKAN;
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
-            .with_title(format!("mislab view — {}", args.scene))
+            .with_title(format!("mislab view — {}", args.scene.scene))
             .with_inner_size([width, height]),
         renderer: eframe::Renderer::Wgpu,
         wgpu_options: egui_wgpu::WgpuConfiguration {

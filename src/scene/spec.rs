@@ -1,0 +1,71 @@
+//! The scene as the command line names it — a file or built-in name, a glTF scene index, an environment map that
+//! replaces the scene's own — and the one way every command (render, view, bench, reference, info) loads it.
+
+use super::{envmap, load, Environment, LoadOptions, Scene};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The scene and its environment override, as on the command line.
+#[derive(clap::Args, Clone, Debug, PartialEq)]
+pub struct SceneSpec {
+    /// A .gltf/.glb/.toml file or a built-in scene: veach-mis, cornell-box, furnace, area-vs-cosine.
+    #[arg(default_value = "veach-mis")]
+    pub scene: String,
+    /// glTF scene index (default: the file's default scene).
+    #[arg(long)]
+    pub gltf_scene: Option<usize>,
+    /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Scale of the --env map.
+    #[arg(long, default_value_t = 1.0)]
+    pub env_scale: f32,
+    /// Rotation of the --env map about +Y, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub env_rotation: f32,
+}
+
+impl Default for SceneSpec {
+    fn default() -> Self {
+        SceneSpec::named("veach-mis")
+    }
+}
+
+impl SceneSpec {
+    /// A scene file or built-in name with no overrides.
+    pub fn named(scene: &str) -> SceneSpec {
+        SceneSpec { scene: scene.into(), gltf_scene: None, env: None, env_scale: 1.0, env_rotation: 0.0 }
+    }
+
+    /// Loads the scene and applies the environment override; prints the loader's warnings once. A scene with
+    /// nothing in it (no geometry, no lights, no environment) is an error, not a black image.
+    pub fn load(&self) -> Result<Scene, String> {
+        if !(self.env_scale.is_finite() && self.env_scale >= 0.0 && self.env_scale <= 1e30) {
+            return Err(format!("--env-scale {} must be a finite number in [0, 1e30]", self.env_scale));
+        }
+        if !self.env_rotation.is_finite() {
+            return Err(format!("--env-rotation {} must be a finite number of degrees", self.env_rotation));
+        }
+        let mut s = load(&self.scene, &LoadOptions { gltf_scene: self.gltf_scene }).map_err(|e| e.to_string())?;
+        if let Some(env) = &self.env {
+            let (map, warnings) = envmap::load_envmap(env).map_err(|e| e.to_string())?;
+            s.warnings.extend(warnings);
+            s.environment = Environment::Map {
+                map: Arc::new(map),
+                scale: self.env_scale,
+                rotation: self.env_rotation.to_radians(),
+            };
+        }
+        let geometry = s.triangle_count() + s.spheres.len() + s.quads.len();
+        if !s.has_lights() && geometry > 0 {
+            s.warnings.push("the scene has no lights and no environment: the image will be black".into());
+        }
+        for w in &s.warnings {
+            eprintln!("warning: {}: {w}", self.scene);
+        }
+        if geometry == 0 && !s.has_lights() {
+            return Err(format!("{}: the scene is empty: no geometry, no lights and no environment", self.scene));
+        }
+        Ok(s)
+    }
+}
