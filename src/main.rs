@@ -56,86 +56,6 @@ enum Command {
     },
 }
 
-/// Estimator settings, the same names as the viewer panel and benchmark files.
-#[derive(Args, Clone)]
-struct SettingsArgs {
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 512)]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 512)]
-    height: u32,
-    /// Seed of every random number.
-    #[arg(long, default_value_t = 0)]
-    seed: u32,
-    /// direct = emission seen by the camera + direct light at the first hit; path = path tracing.
-    #[arg(long, value_enum, default_value_t = Mode::Direct)]
-    mode: Mode,
-    /// Maximum path length in bounces (path mode).
-    #[arg(long, default_value_t = 8)]
-    max_depth: u32,
-    /// Russian roulette from this many bounces on (path mode; at least --max-depth turns it off).
-    #[arg(long, default_value_t = mislab::render::RR_DEPTH)]
-    rr_depth: u32,
-    /// Estimator: uniform, cosine, bsdf, light or mis.
-    #[arg(long, value_enum, default_value_t = Strategy::Mis)]
-    strategy: Strategy,
-    /// Area-light sampling: area or solid-angle.
-    #[arg(long, value_enum, default_value_t = LightSampling::SolidAngle)]
-    light_sampling: LightSampling,
-    /// Environment sampling: uniform or importance.
-    #[arg(long, value_enum, default_value_t = EnvSampling::Importance)]
-    env_sampling: EnvSampling,
-    /// Light selection: uniform or power.
-    #[arg(long, value_enum, default_value_t = LightSelect::Uniform)]
-    light_select: LightSelect,
-    /// MIS heuristic: balance or power.
-    #[arg(long, value_enum, default_value_t = Heuristic::Power)]
-    heuristic: Heuristic,
-    /// Exponent β of the power heuristic.
-    #[arg(long, default_value_t = 2.0)]
-    power_beta: f32,
-    /// MIS flavour: multi (fixed counts per technique) or one (one-sample MIS).
-    #[arg(long = "mis", value_enum, default_value_t = MisKind::Multi)]
-    mis_kind: MisKind,
-    /// Light samples per shading point.
-    #[arg(long, default_value_t = 1)]
-    light_samples: u32,
-    /// BSDF (direction) samples per shading point.
-    #[arg(long, default_value_t = 1)]
-    bsdf_samples: u32,
-    /// Sample sequence.
-    #[arg(long, value_enum, default_value_t = SamplerKind::Independent)]
-    sampler: SamplerKind,
-    /// Exposure in stops (PNG output).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    exposure: f32,
-}
-
-impl SettingsArgs {
-    fn settings(&self) -> Settings {
-        Settings {
-            width: self.width,
-            height: self.height,
-            mode: self.mode,
-            strategy: self.strategy,
-            light_sampling: self.light_sampling,
-            env_sampling: self.env_sampling,
-            light_select: self.light_select,
-            heuristic: self.heuristic,
-            power_beta: self.power_beta,
-            mis: self.mis_kind,
-            light_samples: self.light_samples,
-            bsdf_samples: self.bsdf_samples,
-            sampler: self.sampler,
-            max_depth: self.max_depth,
-            rr_depth: self.rr_depth,
-            seed: self.seed,
-            exposure: self.exposure,
-        }
-    }
-}
-
 #[derive(Args, Clone)]
 struct RenderArgs {
     #[command(flatten)]
@@ -152,8 +72,9 @@ struct RenderArgs {
     /// Tonemapper for PNG output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
     tonemap: Tonemap,
+    /// Estimator settings: the same names as the viewer panel and benchmark files.
     #[command(flatten)]
-    settings: SettingsArgs,
+    settings: Settings,
 }
 
 impl Default for RenderArgs {
@@ -241,7 +162,7 @@ fn stress(filter: Option<&str>) -> Result<u8, Failure> {
 }
 
 fn render(args: RenderArgs) -> Result<u8, Failure> {
-    let settings = args.settings.settings();
+    let settings = args.settings.clone();
     settings.validate().map_err(bad)?;
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if !matches!(ext.as_deref(), Some("png") | Some("exr")) {

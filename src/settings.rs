@@ -132,43 +132,63 @@ settings_enum!(
 );
 
 /// Every setting that changes what is estimated or how. Film size and sample budget live here too so
-/// one struct describes a render (and a benchmark row).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// one struct describes a render (and a benchmark row). Each field is declared once: its doc comment is the
+/// `--flag`'s help, its default is `Settings::default()`'s.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
     /// Image width in pixels.
+    #[arg(long, default_value_t = Settings::default().width)]
     pub width: u32,
     /// Image height in pixels.
+    #[arg(long, default_value_t = Settings::default().height)]
     pub height: u32,
-    /// Direct illumination or path tracing.
+    /// direct = emission seen by the camera + direct light at the first hit (the lecture's shade()); path = path
+    /// tracing with the same estimator for next-event estimation at every vertex.
+    #[arg(long, value_enum, default_value_t = Settings::default().mode)]
     pub mode: Mode,
     /// Estimator for direct illumination.
+    #[arg(long, value_enum, default_value_t = Settings::default().strategy)]
     pub strategy: Strategy,
     /// Area-light sampling technique.
+    #[arg(long, value_enum, default_value_t = Settings::default().light_sampling)]
     pub light_sampling: LightSampling,
     /// Environment sampling technique.
+    #[arg(long, value_enum, default_value_t = Settings::default().env_sampling)]
     pub env_sampling: EnvSampling,
     /// Light selection.
+    #[arg(long, value_enum, default_value_t = Settings::default().light_select)]
     pub light_select: LightSelect,
     /// MIS heuristic.
+    #[arg(long, value_enum, default_value_t = Settings::default().heuristic)]
     pub heuristic: Heuristic,
     /// β of the power heuristic.
+    #[arg(long, default_value_t = Settings::default().power_beta)]
     pub power_beta: f32,
     /// Multi-sample or one-sample MIS.
+    #[arg(long, value_enum, default_value_t = Settings::default().mis)]
     pub mis: MisKind,
     /// Light samples per shading point (MIS multi, light strategy).
+    #[arg(long, default_value_t = Settings::default().light_samples)]
     pub light_samples: u32,
     /// BSDF samples per shading point (MIS multi, BSDF strategies).
+    #[arg(long, default_value_t = Settings::default().bsdf_samples)]
     pub bsdf_samples: u32,
     /// Sample sequence.
+    #[arg(long, value_enum, default_value_t = Settings::default().sampler)]
     pub sampler: SamplerKind,
-    /// Maximum number of bounces in path mode (1 = direct lighting only).
+    /// Maximum path length in bounces (path mode; 1 = direct lighting only).
+    #[arg(long, default_value_t = Settings::default().max_depth)]
     pub max_depth: u32,
-    /// Russian roulette decides whether paths continue from this bounce count on (path mode; ≥ max_depth: never).
+    /// Russian roulette decides whether paths continue from this many bounces on (path mode; ≥ --max-depth turns
+    /// it off).
+    #[arg(long, default_value_t = Settings::default().rr_depth)]
     pub rr_depth: u32,
     /// Seed of every random number.
+    #[arg(long, default_value_t = Settings::default().seed)]
     pub seed: u32,
-    /// Exposure in stops for PNG output and display.
+    /// Exposure in stops for PNG output and display (EXR output is linear radiance and ignores it).
+    #[arg(long, allow_hyphen_values = true, default_value_t = Settings::default().exposure)]
     pub exposure: f32,
 }
 
