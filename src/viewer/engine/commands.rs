@@ -46,10 +46,14 @@ impl Engine {
             }
             Command::Display(d) => self.options = d,
             Command::OpenScene(name) => {
-                let hook = std::panic::take_hook();
-                std::panic::set_hook(Box::new(|_| {}));
-                let loaded = scene::load(&name, &LoadOptions::default());
-                std::panic::set_hook(hook);
+                // No panic hook of our own swapped here (issue 12): `scene::load` already catches its file
+                // loaders' panics, and `catch_quietly` covers the rest (building a built-in scene). It
+                // silences only this thread's panic, so a panic on the UI or compile thread meanwhile is
+                // still printed, and a panicking load becomes a message instead of stopping the engine (the
+                // swap it replaces left the silent hook installed for good when the load panicked).
+                let loaded = scene::catch_quietly(|| scene::load(&name, &LoadOptions::default()))
+                    .map_err(|panic| format!("loading {name} failed: {panic}"))
+                    .and_then(|r| r.map_err(|e| e.to_string()));
                 match loaded {
                     Ok(sc) => {
                         let warnings = sc.warnings.len();
