@@ -341,30 +341,28 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
 
 /// Runs `f`, turning a panic into `Err(its message)` without printing it: a decoder or loader that panics on
 /// a malformed file is reported as an error about that file, not as a crash. Panics on other threads, and
-/// outside `f`, still reach the previous panic hook.
+/// outside `f`, still reach the panic hook that was in place.
+///
+/// The process's panic hook is wrapped once, the first time this runs, by one that stays silent while the
+/// panicking thread is inside `catch_quietly` and otherwise calls the hook it wrapped; it is never swapped
+/// back and forth, so concurrent loads on several threads cannot restore hooks out of order.
 pub(crate) fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     use std::cell::Cell;
-    use std::panic::{self, PanicHookInfo};
-    use std::sync::Arc;
-    type Hook = Box<dyn Fn(&PanicHookInfo<'_>) + Sync + Send + 'static>;
+    use std::panic;
     thread_local!(static QUIET: Cell<u32> = const { Cell::new(0) });
+    static WRAP: std::sync::Once = std::sync::Once::new();
 
-    let previous: Arc<Hook> = Arc::new(panic::take_hook());
-    let shared = previous.clone();
-    panic::set_hook(Box::new(move |info| {
-        if QUIET.with(Cell::get) == 0 {
-            shared(info)
-        }
-    }));
+    WRAP.call_once(|| {
+        let previous = panic::take_hook();
+        panic::set_hook(Box::new(move |info| {
+            if QUIET.with(Cell::get) == 0 {
+                previous(info)
+            }
+        }));
+    });
     QUIET.with(|q| q.set(q.get() + 1));
     let result = panic::catch_unwind(panic::AssertUnwindSafe(f));
     QUIET.with(|q| q.set(q.get() - 1));
-    // Put the previous hook back (unwrapped, so repeated calls do not nest hooks).
-    drop(panic::take_hook());
-    match Arc::try_unwrap(previous) {
-        Ok(hook) => panic::set_hook(hook),
-        Err(shared) => panic::set_hook(Box::new(move |info| shared(info))),
-    }
     result.map_err(|panic| {
         panic
             .downcast_ref::<String>()
