@@ -46,7 +46,7 @@ pub const DEFAULT_LADDER: [u32; 11] = [1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 10
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 pub enum Suite {
     /// The lecture's comparisons: direction strategies, light sampling, environment sampling, MIS heuristics,
-    /// samplers (on veach-mis, area-vs-cosine, a sphere and DamagedHelmet under noon_grass_1k.hdr, cornell-box).
+    /// samplers (on veach-mis, area-vs-cosine, a sphere and metal-rough spheres under noon_grass_1k.hdr, cornell-box).
     Lecture,
 }
 
