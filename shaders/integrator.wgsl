@@ -1,5 +1,10 @@
 // integrator.wgsl — the entry point: camera rays, the path loop (direct mode = one vertex), and the
 // per-pixel accumulation of this dispatch's samples into the running mean / second moment.
+//
+// One trace per path vertex (as Mitsuba 3's path.cpp and pbrt-v4's PathIntegrator): the ray a vertex continues
+// along is also its direction technique's sample, so the next trace finds the next vertex and the emission that
+// sample counts (weighted by MIS against the light technique's pdf) at once. Camera rays, continuations and
+// emission share one trace site — on lavapipe every call site's code runs whether or not a lane needs it.
 
 const WORKGROUP: u32 = 8u;
 /// Hard bound on path length whatever the settings say (lavapipe has no watchdog).
@@ -13,62 +18,71 @@ fn camera_direction(px: vec2<u32>, jitter: vec2<f32>) -> vec3<f32> {
     return normalize(params.cam_forward + x * params.cam_right + y * params.cam_up);
 }
 
-/// A path in flight: its sample, the vertex it is at, the ray that found that vertex, and what it carries.
-struct Path {
+/// A path between two vertices: the ray whose hit is its next vertex, and how to count the emission found there.
+struct PathRay {
     id: SampleId,
-    bounce: u32,
+    bounce: u32,             // the vertex this ray finds
+    o: vec3<f32>,
     d: vec3<f32>,
-    hit: Hit,
-    x: Surface,
-    l: vec3<f32>,
-    beta: vec3<f32>,
+    from_p: vec3<f32>,       // the shading point it leaves (for the light technique's pdf of what it finds)
+    dir_pdf: f32,            // pdf of the direction technique that chose d
+    emission_scale: f32,     // factor on the emission it finds (0: not a counted direction sample)
+    light: LightEstimate,    // the first light sample taken at from_p
+    beta: vec3<f32>,         // throughput, including f·cos/pdf of d
+    l: vec3<f32>,            // radiance gathered so far
 }
 
-/// Starts a sample: the camera ray through the pixel, traced.
-fn start_path(px: vec2<u32>, id: SampleId) -> Path {
-    var p: Path;
-    p.id = id;
-    p.bounce = 0u;
-    p.d = camera_direction(px, sample_2d(id, 0u));
+fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
+    var r: PathRay;
+    r.id = id;
+    r.bounce = 0u;
+    r.o = params.cam_origin;
+    r.d = camera_direction(px, sample_2d(id, 0u));
+    r.from_p = params.cam_origin;
+    r.dir_pdf = 0.0;
+    r.emission_scale = 1.0;
+    r.light = LightEstimate(vec3<f32>(0.0), MEASURE_NONE, 0.0);
+    r.beta = vec3<f32>(1.0);
+    r.l = vec3<f32>(0.0);
+    return r;
+}
+
+/// Traces the path's ray, counts the emission it finds, shades the vertex there and sets the next ray. Returns
+/// false when the path has ended (its radiance is then complete in r.l). Vertices 0 .. depth − 1 are shaded;
+/// the ray leaving the last one is traced only for the emission it finds.
+fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
+    let ray = *r;
     rays_traced += 1u;
-    p.hit = trace_closest(params.cam_origin, p.d, F32_MAX);
-    // The shading point at `hit`: shade() returns the next one with its continuation ray.
-    p.x = surface_at(p.hit, params.cam_origin, p.d);
-    p.l = vec3<f32>(0.0);
-    p.beta = vec3<f32>(1.0);
-    return p;
-}
-
-/// Shades the path's vertex and moves it to the next one. Returns false when the path has ended (its radiance
-/// is then complete in p.l).
-fn path_step(p: ptr<function, Path>, depth: u32) -> bool {
-    let bounce = (*p).bounce;
-    if ((*p).hit.prim == INVALID) {
-        // Only the camera ray adds the environment here; later vertices counted it in shade().
-        if (bounce == 0u && params.env_light != INVALID) { (*p).l += env_eval((*p).d); }
-        return false;
-    }
-    let x = (*p).x;
-    let m = scene_material(x.material);
-    if (bounce == 0u && x.front) { (*p).l += material_emission(m, x.uv); }
-    let c = shading_ctx(x, m, (*p).d, (*p).id, bounce);
-    let want_next = bounce + 1u < depth;
+    let hit = trace_closest(ray.o, ray.d, F32_MAX);
+    let found = found_emission(ray.from_p, ray.o, ray.d, hit, ray.light);
+    var w = ray.emission_scale;
+    // The camera ray is no direction technique's sample: its emission counts in full.
+    if (ray.bounce > 0u) { w *= direction_mis_weight(ray.dir_pdf, found.p_light); }
+    (*r).l += ray.beta * (w * found.le);
+    if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
+    let x = found.surface;
+    let c = shading_ctx(x, scene_material(x.material), ray.d, ray.id, ray.bounce);
+    let want_next = ray.bounce + 1u < depth;
     let s = shade(c, want_next);
-    (*p).l += (*p).beta * s.radiance;
+    (*r).l += ray.beta * s.radiance;
     if (!s.next_valid) { return false; }
-    var beta = (*p).beta * s.next_weight;
-    if (bounce + 1u >= params.rr_depth) {
-        // Russian roulette: continue with probability max(β), at least 5%.
+    var beta = ray.beta * s.next_weight;
+    if (want_next && ray.bounce + 1u >= params.rr_depth) {
+        // Russian roulette, decided before the ray is traced: a surviving path counts what it finds with β/q (as
+        // pbrt-v4 does). Continue with probability max(β), at least 5%.
         let q = clamp(max(beta.x, max(beta.y, beta.z)), 0.05, 1.0);
-        if (sample_1d(c.id, dim_base(bounce, 0u) + DIM_RR) >= q) { return false; }
+        if (sample_1d(c.id, dim_base(ray.bounce, 0u) + DIM_RR) >= q) { return false; }
         beta /= q;
     }
     if (all(beta == vec3<f32>(0.0))) { return false; }
-    (*p).beta = beta;
-    (*p).bounce = bounce + 1u;
-    (*p).d = s.next_dir;
-    (*p).hit = s.next_hit;
-    (*p).x = s.next_surface;
+    (*r).bounce = ray.bounce + 1u;
+    (*r).o = s.next_origin;
+    (*r).d = s.next_dir;
+    (*r).from_p = x.p;
+    (*r).dir_pdf = s.next_pdf;
+    (*r).emission_scale = s.next_scale;
+    (*r).light = s.light;
+    (*r).beta = beta;
     return true;
 }
 
@@ -86,88 +100,6 @@ fn accumulate(a: ptr<function, Accum>, bad: ptr<function, u32>, v: vec3<f32>) {
     (*a).m2 += delta * (v - (*a).mean);
 }
 
-/// A path in the deferred design (baked path-tracing pipelines): the ray whose hit is the path's next vertex,
-/// and how to count the emission it finds there. The direction sample that continues a path is also the
-/// direction technique's sample of that vertex's direct light, so its emission is counted one step late, where
-/// the next vertex's one trace finds it: camera rays, continuations and emission share one trace site.
-struct PathRay {
-    id: SampleId,
-    bounce: u32,          // the vertex this ray finds
-    o: vec3<f32>,
-    d: vec3<f32>,
-    from_p: vec3<f32>,    // the shading point it leaves (for the light technique's pdf of what it finds)
-    dir_pdf: f32,         // pdf of the direction technique that chose d
-    emission_scale: f32,  // factor on the emission it finds (0: NEE counted it already)
-    light_omega: f32,     // `omega` of the light sampled at from_p (used where light_omega_reusable())
-    beta: vec3<f32>,      // throughput, including f·cos/pdf of d
-    l: vec3<f32>,         // radiance gathered so far
-}
-
-fn camera_path_ray(px: vec2<u32>, id: SampleId) -> PathRay {
-    var r: PathRay;
-    r.id = id;
-    r.bounce = 0u;
-    r.o = params.cam_origin;
-    r.d = camera_direction(px, sample_2d(id, 0u));
-    r.from_p = params.cam_origin;
-    r.dir_pdf = 0.0;
-    r.emission_scale = 1.0;
-    r.light_omega = 0.0;
-    r.beta = vec3<f32>(1.0);
-    r.l = vec3<f32>(0.0);
-    return r;
-}
-
-/// Traces the path's ray, counts the emission it finds, shades the vertex there (light samples) and sets the
-/// next ray. Returns false when the path has ended (its radiance is then complete in r.l).
-fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
-    let ray = *r;
-    rays_traced += 1u;
-    let hit = trace_closest(ray.o, ray.d, F32_MAX);
-    let found = found_emission(ray.from_p, ray.o, ray.d, hit, light_omega_reusable(), ray.light_omega);
-    var w = ray.emission_scale;
-    // The camera ray is no direction technique's sample: its emission counts in full.
-    if (ray.bounce > 0u) { w *= direction_emission_weight(params.bsdf_samples, ray.dir_pdf, found.p_light); }
-    (*r).l += ray.beta * (w * found.le);
-    if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
-    let x = found.surface;
-    let c = shading_ctx(x, scene_material(x.material), ray.d, ray.id, ray.bounce);
-    let plan = strategy_plan(c);
-    let lights = shade_lights(c, plan);
-    (*r).l += ray.beta * lights.radiance;
-    // The direction sample: the continuation, and (when its emission counts) the last vertex's direct light.
-    let want_next = ray.bounce + 1u < depth;
-    if (!want_next && plan.dir_count == 0u) { return false; }
-    let ds = direction_sample(c, 0u);
-    if (!(ds.w > 0.0)) { return false; }
-    let wd = to_world(c.frame, ds.xyz);
-    if (dot(wd, x.ng) <= 0.0) { return false; }
-    var beta = ray.beta * (bsdf_eval(c.brdf, c.wo, ds.xyz) * ds.z / ds.w);
-    if (want_next && ray.bounce + 1u >= params.rr_depth) {
-        // Russian roulette, decided before the ray is traced: a surviving path's emission is found with β/q.
-        let q = clamp(max(beta.x, max(beta.y, beta.z)), 0.05, 1.0);
-        if (sample_1d(c.id, dim_base(ray.bounce, 0u) + DIM_RR) >= q) { return false; }
-        beta /= q;
-    }
-    if (all(beta == vec3<f32>(0.0))) { return false; }
-    (*r).bounce = ray.bounce + 1u;
-    (*r).o = spawn_origin(x, wd);
-    (*r).d = wd;
-    (*r).from_p = x.p;
-    (*r).dir_pdf = ds.w;
-    (*r).emission_scale = select(0.0, plan.dir_scale, plan.dir_count > 0u);
-    (*r).light_omega = lights.omega;
-    (*r).beta = beta;
-    return true;
-}
-
-/// Whether this pipeline uses the deferred design: baked scenes (no BVH walks to keep in step), path tracing
-/// (direct mode would need a second loop iteration per sample), and one direction sample per vertex (fixed at
-/// pipeline creation; more would each need their own trace site).
-fn deferred_paths() -> bool {
-    return FLAT_SCENE && cfg_mode() == MODE_PATH && SPEC_ONE_DIRECTION == 1u;
-}
-
 @compute @workgroup_size(8, 8, 1)
 fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     bvh_set_lane(lid);
@@ -179,9 +111,12 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
     let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);
     var a = accum[pixel];
     var bad = 0u;
-    if (deferred_paths()) {
-        // As below, one loop over vertices with restarts, but each iteration traces one ray (see PathRay).
-        var ray = camera_path_ray(px, SampleId(pixel, params.sample_base));
+    if (FLAT_SCENE) {
+        // One loop over path vertices, not one per sample: a lane whose path ends starts its next sample at
+        // once. lavapipe runs a loop's SIMD lanes until the last one is done, so with a loop per sample every
+        // lane waited for the longest path among its neighbours'. (With a BVH, lanes that restart at different
+        // times would walk the tree apart, so BVH scenes keep the loop per sample below.)
+        var ray = camera_ray(px, SampleId(pixel, params.sample_base));
         var started = 1u;
         var done = 0u;
         for (var it = 0u; it < n * (depth + 1u) && done < n; it += 1u) {
@@ -189,32 +124,15 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
             accumulate(&a, &bad, ray.l);
             done += 1u;
             if (started < n) {
-                ray = camera_path_ray(px, SampleId(pixel, params.sample_base + started));
-                started += 1u;
-            }
-        }
-    } else if (FLAT_SCENE) {
-        // One loop over path vertices, not one per sample: a lane whose path ends starts its next sample at
-        // once. lavapipe runs a loop's SIMD lanes until the last one is done, so with a loop per sample every
-        // lane waited for the longest path among its neighbours'. (With a BVH, lanes that restart at different
-        // times would walk the tree apart, so BVH scenes keep the loop per sample below.)
-        var path = start_path(px, SampleId(pixel, params.sample_base));
-        var started = 1u;
-        var done = 0u;
-        for (var it = 0u; it < n * (depth + 1u) && done < n; it += 1u) {
-            if (path_step(&path, depth)) { continue; }
-            accumulate(&a, &bad, path.l);
-            done += 1u;
-            if (started < n) {
-                path = start_path(px, SampleId(pixel, params.sample_base + started));
+                ray = camera_ray(px, SampleId(pixel, params.sample_base + started));
                 started += 1u;
             }
         }
     } else {
         for (var i = 0u; i < n; i += 1u) {
-            var path = start_path(px, SampleId(pixel, params.sample_base + i));
-            for (var k = 0u; k < depth && path_step(&path, depth); k += 1u) {}
-            accumulate(&a, &bad, path.l);
+            var ray = camera_ray(px, SampleId(pixel, params.sample_base + i));
+            for (var k = 0u; k <= depth && path_vertex(&ray, depth); k += 1u) {}
+            accumulate(&a, &bad, ray.l);
         }
     }
     a.nonfinite += bad;

@@ -1,35 +1,43 @@
-// lights.wgsl — light techniques: sample_li / pdf_li for area lights (triangle, quad, sphere), delta lights
-// (point, spot, directional) and the environment, plus light selection. All pdfs are per unit solid angle
-// at the shading point and do NOT include the selection probability (see `light_pmf`).
+// lights.wgsl — the light techniques, one section per light kind, and light selection.
+//
+// Contract (pbrt-v4's Light::SampleLi / PDF_Li / L). Every kind K (`LIGHT_K` in common.wgsl) has one section with:
+//   K_sample_li(l, p, u) -> LightSample   a direction wi from p towards light l, drawn with u ∈ [0,1)³: the
+//                                         distance to the light point, the radiance arriving along wi unoccluded
+//                                         (delta lights: intensity/d² or irradiance), its pdf per unit solid angle
+//                                         at p (0 = no sample) and the measure it was drawn in;
+//   K_pdf_li(l, p, wi, y, n_y) -> f32     the pdf per unit solid angle that K_sample_li draws wi, which meets the
+//                                         light at y with geometric normal n_y (either orientation); 0 for delta
+//                                         lights;
+//   K_eval(l, y, wi) -> vec3<f32>         the radiance the light emits along wi from the point y a ray found (the
+//                                         environment ignores y); 0 for delta lights, which no ray finds.
+// No pdf here includes the selection probability (`light_pmf`). Emitters are one-sided: from behind a triangle
+// or quad, p gets no light and pdf_li is 0. The dispatchers light_sample_li / light_pdf_li / light_eval (last
+// section) have one `case` per kind; tests/shaders.rs checks that and that nothing else switches on the kind.
 
-/// A sampled direction towards a light: unit wi, distance to the light point (F32_MAX for distant
-/// lights), the radiance arriving along wi (for delta lights: intensity/d² or irradiance), the pdf in
-/// solid angle (0 = no sample), whether the technique is a delta distribution, and `omega`: for an area light,
-/// what its pdf at any point depends on, as `light_pdf_given_omega` takes it (Ω > 0 when sampled uniformly in
-/// solid angle, −1 when by area, 0 when p sees no light from it).
+/// The measure a light sample was drawn in. For an area light MEASURE_SOLID_ANGLE is uniform in the solid angle it
+/// subtends (spherical triangle, spherical rectangle, cone), so its pdf holds for every direction that meets the
+/// light from the same p; MEASURE_AREA is uniform by area, converted per direction by d²/cos.
+const MEASURE_NONE: u32 = 0u;
+const MEASURE_SOLID_ANGLE: u32 = 1u;
+const MEASURE_AREA: u32 = 2u;
+const MEASURE_DISCRETE: u32 = 3u;
+
+/// A sampled direction towards a light (see the contract above). `prim` is the light's own primitive reference,
+/// which a shadow ray towards it must not count as an occluder (INVALID for delta and environment lights).
 struct LightSample {
     wi: vec3<f32>,
     dist: f32,
     radiance: vec3<f32>,
     pdf: f32,
-    delta: bool,
-    omega: f32,
+    measure: u32,
+    prim: u32,
 }
 
 fn no_light_sample() -> LightSample {
-    return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, false, 0.0);
+    return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, MEASURE_NONE, INVALID);
 }
 
-/// The primitive an area light is (a primitive reference), or INVALID for delta and environment lights.
-fn light_prim_ref(i: u32) -> u32 {
-    let l = scene_light(i);
-    switch l.kind {
-        case LIGHT_TRIANGLE: { return make_prim(PRIM_TRIANGLE, l.prim); }
-        case LIGHT_SPHERE: { return make_prim(PRIM_SPHERE, l.prim); }
-        case LIGHT_QUAD: { return make_prim(PRIM_QUAD, l.prim); }
-        default: { return INVALID; }
-    }
-}
+// ---- light selection ----
 
 /// Probability of choosing light `i` under the active selection scheme.
 fn light_pmf(i: u32) -> f32 {
@@ -72,104 +80,18 @@ fn select_light(u: f32) -> u32 {
     return min(u32(u * f32(n)), n - 1u);
 }
 
-// ---- area lights: uniform by area, converted to solid angle by distance² / cos ----
-
-/// Area-to-solid-angle conversion for a sampled light point y with normal n_y, seen from p.
-/// One-sided: a point seen from behind has pdf 0 (it emits nothing towards p).
-fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32, emitted: vec3<f32>) -> LightSample {
-    let v = y - p;
-    let d2 = dot(v, v);
-    let dist = sqrt(d2);
-    let wi = v / dist;
-    let cos_l = dot(-wi, n_y);
-    if (!(cos_l > 0.0) || !(d2 > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, false, -1.0);
-}
-
-/// Triangle light, uniform by area (barycentrics by Heitz's low-distortion map). Measure: area → solid angle.
-fn triangle_sample_li(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let tp = scene_tri_positions(prim);
-    let v0 = tp.v0;
-    let v1 = tp.v1;
-    let v2 = tp.v2;
-    let c = cross(v1 - v0, v2 - v0);
-    let area2 = length(c);
-    if (!(area2 > 0.0)) { return no_light_sample(); }
-    let b = square_to_uniform_triangle(u);
-    let y = (1.0 - b.x - b.y) * v0 + b.x * v1 + b.y * v2;
-    let sh = scene_tri_shading(prim);
-    let uv = (1.0 - b.x - b.y) * sh.uv0 + b.x * sh.uv1 + b.y * sh.uv2;
-    let emitted = material_emission(scene_material(sh.material), uv);
-    return area_to_solid_angle(p, y, c / area2, 2.0 / area2, emitted);
-}
-
-/// Quad light, uniform by area. Measure: area → solid angle.
-fn quad_sample_li(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let q = scene_quad(prim);
-    let c = cross(q.edge_u, q.edge_v);
-    let area = length(c);
-    if (!(area > 0.0)) { return no_light_sample(); }
-    let y = q.corner + u.x * q.edge_u + u.y * q.edge_v;
-    let emitted = material_emission(scene_material(q.material), u);
-    return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted);
-}
-
-/// Sphere light, uniform by area over the whole sphere. Points on the far side face away from p and come back
-/// as failed samples (pdf 0), so the pdf of the successful ones integrates to the visible fraction of the area.
-/// Measure: area → solid angle.
-fn sphere_sample_li_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let s = scene_sphere(prim);
-    let n = square_to_uniform_sphere(u);
-    let y = s.center + s.radius * n;
-    let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
-    let emitted = material_emission(scene_material(s.material), uv);
-    return area_to_solid_angle(p, y, n, 1.0 / (4.0 * PI * s.radius * s.radius), emitted);
-}
-
-/// 1 − cosθmax of the cone a sphere subtends from p, or a negative value when p is inside (or so close
-/// to the surface that the cone is numerically a hemisphere): then callers fall back to area sampling.
-/// Written via sin²θmax/(1 + cosθmax) so tiny spheres keep their precision.
-fn sphere_cone_one_minus_cos(s: Sphere, p: vec3<f32>) -> f32 {
-    let d2 = dot(s.center - p, s.center - p);
-    let r2 = s.radius * s.radius;
-    if (!(d2 > r2 * 1.0001)) { return -1.0; }
-    let sin2 = r2 / d2;
-    return sin2 / (1.0 + sqrt(1.0 - sin2));
-}
-
-/// Sphere light, uniform in the subtended cone (solid angle). Measure: solid angle.
-fn sphere_sample_li_cone(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let s = scene_sphere(prim);
-    let omc = sphere_cone_one_minus_cos(s, p);
-    if (omc <= 0.0) { return sphere_sample_li_area(prim, p, u); }
-    let to_c = s.center - p;
-    let d = length(to_c);
-    let f = frame_from_normal(to_c / d);
-    let wl = square_to_uniform_cone(u, omc);
-    let wi = normalize(to_world(f, wl));
-    // Distance along wi to the near intersection: t = d·cosθ − sqrt(r² − d²·sin²θ). sin²θ from the transverse
-    // components (1 − z² has no digits left in a tiny cone).
-    let sin2 = wl.x * wl.x + wl.y * wl.y;
-    let cos_t = wl.z;
-    let t = max(d * cos_t - safe_sqrt(s.radius * s.radius - d * d * sin2), 0.0);
-    let y = p + t * wi;
-    let n = normalize(y - s.center);
-    let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
-    let emitted = material_emission(scene_material(s.material), uv);
-    return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), false, TWO_PI * omc);
-}
-
-// ---- triangle and quad lights by solid angle (spherical triangle / spherical rectangle) ----
+// ---- area lights in common ----
 //
-// Fallback to area sampling, a deterministic function of (light, shading point) shared by sample_li and pdf_li:
-// the spherical warps are used only where their f32 error on this platform stays below 1e-4 — sample positions
-// in units of the light's size and Ω relative, against f64 twins, over far / close (above the centre, an edge, a
-// vertex) / grazing viewpoints of regular and 100:1 sliver shapes (tests/sampling.rs `spherical_warps_precision`;
-// the table is in docs/sampling.md). Measured: triangles break down below ~6e-6 sr (slivers; regular ones hold to
-// ~1e-7 sr) and above ~5.8 sr (a viewpoint within ~1/1000 of the light's size of its plane, near an edge);
-// rectangles below ~2e-5 sr (slivers) and above ~5.8 sr (near a corner). Below the minimum the light is small and
-// area sampling is nearly as good (its pdf is nearly constant over the light); above the maximum the viewpoint
-// almost touches the light.
+// By area: uniform on the surface, converted to solid angle by d²/cos. By solid angle (spherical triangle,
+// spherical rectangle, cone) where the warp is accurate, else by area: that choice is a deterministic function
+// of (light, p), made by one function per kind (`*_measure`) that sample_li and pdf_li share. The spherical warps
+// are used only where their f32 error on this platform stays below 1e-4 — sample positions in units of the
+// light's size and Ω relative, against f64 twins, over far / close (above the centre, an edge, a vertex) /
+// grazing viewpoints of regular and 100:1 sliver shapes (tests/sampling.rs `spherical_warps_precision`; the table
+// is in docs/sampling.md). Measured: triangles break down below ~6e-6 sr (slivers; regular ones hold to ~1e-7 sr)
+// and above ~5.8 sr (a viewpoint within ~1/1000 of the light's size of its plane, near an edge); rectangles below
+// ~2e-5 sr (slivers) and above ~5.8 sr (near a corner). Below the minimum the light is small and area sampling is
+// nearly as good (its pdf is nearly constant over the light); above the maximum p almost touches the light.
 
 /// Spherical-triangle sampling is used for triangles subtending [SPHERICAL_TRIANGLE_MIN_SR, SPHERICAL_TRIANGLE_MAX_SR].
 const SPHERICAL_TRIANGLE_MIN_SR: f32 = 1e-5;
@@ -181,27 +103,71 @@ const SPHERICAL_RECT_MAX_SR: f32 = 5.5;
 /// sampled by area in either mode.
 const RECT_COS_TOLERANCE: f32 = 1e-5;
 
-/// Solid angle of triangle light `prim` as its solid-angle sampler uses it: Ω > 0 when spherical sampling
-/// applies, −1 when p is in front but area sampling is used (Ω out of range), 0 when p sees its back or lies in
-/// its plane (no light reaches p).
-fn triangle_light_omega(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32>) -> f32 {
-    let n = cross(v1 - v0, v2 - v0);
-    if (!(dot(p - v0, n) > 0.0)) { return 0.0; }
-    let omega = spherical_triangle_solid_angle(v0 - p, v1 - p, v2 - p);
-    if (omega >= SPHERICAL_TRIANGLE_MIN_SR && omega <= SPHERICAL_TRIANGLE_MAX_SR) { return omega; }
-    return -1.0;
+/// How an area light's sampler draws directions from p: MEASURE_NONE (p sees its back: no light), MEASURE_AREA,
+/// or MEASURE_SOLID_ANGLE over the solid angle `omega`.
+struct AreaMeasure {
+    measure: u32,
+    omega: f32,
 }
 
-/// Triangle light, uniform in solid angle (spherical triangle), else by area. Measure: solid angle.
-fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+/// Area-to-solid-angle conversion for a sampled light point y with normal n_y, seen from p.
+/// One-sided: a point seen from behind has pdf 0 (it emits nothing towards p).
+fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32, emitted: vec3<f32>, prim: u32) -> LightSample {
+    let v = y - p;
+    let d2 = dot(v, v);
+    let dist = sqrt(d2);
+    let wi = v / dist;
+    let cos_l = dot(-wi, n_y);
+    if (!(cos_l > 0.0) || !(d2 > 0.0)) { return no_light_sample(); }
+    return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, MEASURE_AREA, prim);
+}
+
+/// The emission of an area light at the point y a ray found: its material's, on the front face only.
+fn area_eval(y: Surface) -> vec3<f32> {
+    if (!y.front) { return vec3<f32>(0.0); }
+    return material_emission(scene_material(y.material), y.uv);
+}
+
+// ---- LIGHT_TRIANGLE: a mesh triangle of an emissive material ----
+
+/// Spherical-triangle sampling where accurate (solid-angle mode), else by area; NONE when p sees the back.
+fn triangle_measure(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32>) -> AreaMeasure {
+    let n = cross(v1 - v0, v2 - v0);
+    if (!(dot(p - v0, n) > 0.0)) { return AreaMeasure(MEASURE_NONE, 0.0); }
+    if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE) {
+        let omega = spherical_triangle_solid_angle(v0 - p, v1 - p, v2 - p);
+        if (omega >= SPHERICAL_TRIANGLE_MIN_SR && omega <= SPHERICAL_TRIANGLE_MAX_SR) {
+            return AreaMeasure(MEASURE_SOLID_ANGLE, omega);
+        }
+    }
+    return AreaMeasure(MEASURE_AREA, 0.0);
+}
+
+/// Uniform by area (barycentrics by Heitz's low-distortion map). Measure: area → solid angle.
+fn triangle_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let tp = scene_tri_positions(prim);
+    let c = cross(tp.v1 - tp.v0, tp.v2 - tp.v0);
+    let area2 = length(c);
+    if (!(area2 > 0.0)) { return no_light_sample(); }
+    let b = square_to_uniform_triangle(u);
+    let y = (1.0 - b.x - b.y) * tp.v0 + b.x * tp.v1 + b.y * tp.v2;
+    let sh = scene_tri_shading(prim);
+    let uv = (1.0 - b.x - b.y) * sh.uv0 + b.x * sh.uv1 + b.y * sh.uv2;
+    let emitted = material_emission(scene_material(sh.material), uv);
+    return area_to_solid_angle(p, y, c / area2, 2.0 / area2, emitted, make_prim(PRIM_TRIANGLE, prim));
+}
+
+/// Uniform in solid angle (spherical triangle, Arvo 1995) where `triangle_measure` allows, else by area.
+fn triangle_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return triangle_sample_area(l.prim, p, u.xy); }
+    let tp = scene_tri_positions(l.prim);
     let v0 = tp.v0;
     let v1 = tp.v1;
     let v2 = tp.v2;
-    let omega = triangle_light_omega(v0, v1, v2, p);
-    if (omega == 0.0) { return no_light_sample(); }
-    if (omega < 0.0) { return triangle_sample_li(prim, p, u); }
-    let wi = spherical_triangle_warp(u, v0 - p, v1 - p, v2 - p, omega);
+    let m = triangle_measure(v0, v1, v2, p);
+    if (m.measure == MEASURE_NONE) { return no_light_sample(); }
+    if (m.measure == MEASURE_AREA) { return triangle_sample_area(l.prim, p, u.xy); }
+    let wi = spherical_triangle_warp(u.xy, v0 - p, v1 - p, v2 - p, m.omega);
     // The light point: wi meets the triangle's plane at t = (v0 − p)·n / (wi·n).
     let n = cross(v1 - v0, v2 - v0);
     let t = dot(v0 - p, n) / dot(wi, n);
@@ -210,15 +176,32 @@ fn triangle_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> Ligh
     let inv_nn = 1.0 / dot(n, n);
     let b1 = clamp(dot(cross(y - v0, v2 - v0), n) * inv_nn, 0.0, 1.0);
     let b2 = clamp(dot(cross(v1 - v0, y - v0), n) * inv_nn, 0.0, 1.0);
-    let sh = scene_tri_shading(prim);
+    let sh = scene_tri_shading(l.prim);
     let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
     let emitted = material_emission(scene_material(sh.material), uv);
-    return LightSample(wi, t, emitted, 1.0 / omega, false, omega);
+    return LightSample(wi, t, emitted, 1.0 / m.omega, MEASURE_SOLID_ANGLE, make_prim(PRIM_TRIANGLE, l.prim));
 }
 
-/// A quad light's frame for spherical-rectangle sampling: unit edges x, y, front normal z, edge lengths, and
-/// the spherical rectangle seen from p (`rect.omega` ≤ 0: see `quad_light_frame`).
+fn triangle_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    let tp = scene_tri_positions(l.prim);
+    let m = triangle_measure(tp.v0, tp.v1, tp.v2, p);
+    if (m.measure == MEASURE_SOLID_ANGLE) { return 1.0 / m.omega; }
+    if (m.measure == MEASURE_NONE) { return 0.0; }
+    // By area: (2/|n|)·d² / cos_l with cos_l = |wi·n|/|n|.
+    let v = y - p;
+    let c = abs(dot(wi, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)));
+    if (!(c > 0.0)) { return 0.0; }
+    return 2.0 * dot(v, v) / c;
+}
+
+fn triangle_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(y); }
+
+// ---- LIGHT_QUAD: an emissive parallelogram ----
+
+/// A quad light seen from p: how it is sampled (`measure`, and for solid angle the spherical rectangle `rect`),
+/// with its unit edges x, y, front normal z and edge lengths.
 struct QuadLightFrame {
+    measure: u32,
     x: vec3<f32>,
     y: vec3<f32>,
     z: vec3<f32>,
@@ -227,15 +210,16 @@ struct QuadLightFrame {
     rect: SphericalRect,
 }
 
-/// Like `triangle_light_omega` for quads: `rect.omega` > 0 when spherical-rectangle sampling applies, −1 when p
-/// is in front but area sampling is used (not a rectangle, or Ω out of range), 0 when p sees its back.
-fn quad_light_frame(q: Quad, p: vec3<f32>) -> QuadLightFrame {
+/// Spherical-rectangle sampling where accurate (a rectangle, solid-angle mode), else by area; NONE when p sees the
+/// back. The frame is set up only for solid angle.
+fn quad_measure(q: Quad, p: vec3<f32>) -> QuadLightFrame {
     var f: QuadLightFrame;
-    f.rect.omega = 0.0;
+    f.measure = MEASURE_NONE;
     let c = cross(q.edge_u, q.edge_v);
     let d = q.corner - p;
     if (!(dot(-d, c) > 0.0)) { return f; }
-    f.rect.omega = -1.0;
+    f.measure = MEASURE_AREA;
+    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return f; }
     f.lu = length(q.edge_u);
     f.lv = length(q.edge_v);
     if (!(abs(dot(q.edge_u, q.edge_v)) <= RECT_COS_TOLERANCE * f.lu * f.lv)) { return f; }
@@ -243,54 +227,148 @@ fn quad_light_frame(q: Quad, p: vec3<f32>) -> QuadLightFrame {
     f.y = q.edge_v / f.lv;
     f.z = normalize(c);
     let r = spherical_rect_setup(dot(d, f.x), dot(d, f.y), f.lu, f.lv, -dot(d, f.z));
-    if (r.omega >= SPHERICAL_RECT_MIN_SR && r.omega <= SPHERICAL_RECT_MAX_SR) { f.rect = r; }
+    if (r.omega >= SPHERICAL_RECT_MIN_SR && r.omega <= SPHERICAL_RECT_MAX_SR) {
+        f.measure = MEASURE_SOLID_ANGLE;
+        f.rect = r;
+    }
     return f;
 }
 
-/// Quad light, uniform in solid angle (spherical rectangle) when it is a rectangle, else by area.
-/// Measure: solid angle.
-fn quad_sample_li_solid_angle(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+/// Uniform by area. Measure: area → solid angle.
+fn quad_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     let q = scene_quad(prim);
-    let f = quad_light_frame(q, p);
-    if (f.rect.omega == 0.0) { return no_light_sample(); }
-    if (f.rect.omega < 0.0) { return quad_sample_li(prim, p, u); }
-    let xy = square_to_spherical_rectangle(u, f.rect);
+    let c = cross(q.edge_u, q.edge_v);
+    let area = length(c);
+    if (!(area > 0.0)) { return no_light_sample(); }
+    let y = q.corner + u.x * q.edge_u + u.y * q.edge_v;
+    let emitted = material_emission(scene_material(q.material), u);
+    return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted, make_prim(PRIM_QUAD, prim));
+}
+
+/// Uniform in solid angle (spherical rectangle, Ureña et al. 2013) where `quad_measure` allows, else by area.
+fn quad_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return quad_sample_area(l.prim, p, u.xy); }
+    let q = scene_quad(l.prim);
+    let f = quad_measure(q, p);
+    if (f.measure == MEASURE_NONE) { return no_light_sample(); }
+    if (f.measure == MEASURE_AREA) { return quad_sample_area(l.prim, p, u.xy); }
+    let xy = square_to_spherical_rectangle(u.xy, f.rect);
     let v = xy.x * f.x + xy.y * f.y - f.rect.h * f.z;
     let dist = length(v);
     let st = vec2<f32>((xy.x - f.rect.x0) / f.lu, (xy.y - f.rect.y0) / f.lv);
     let emitted = material_emission(scene_material(q.material), st);
-    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, false, f.rect.omega);
+    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, MEASURE_SOLID_ANGLE, make_prim(PRIM_QUAD, l.prim));
 }
 
-// ---- delta lights ----
+fn quad_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    let q = scene_quad(l.prim);
+    let f = quad_measure(q, p);
+    if (f.measure == MEASURE_SOLID_ANGLE) { return 1.0 / f.rect.omega; }
+    if (f.measure == MEASURE_NONE) { return 0.0; }
+    // By area: d² / (A·cos_l) = d² / |wi·(edge_u × edge_v)|.
+    let v = y - p;
+    let c = abs(dot(wi, cross(q.edge_u, q.edge_v)));
+    if (!(c > 0.0)) { return 0.0; }
+    return dot(v, v) / c;
+}
+
+fn quad_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(y); }
+
+// ---- LIGHT_SPHERE: an emissive sphere ----
+
+/// 1 − cosθmax of the cone a sphere subtends from p, or a negative value when p is inside (or so close
+/// to the surface that the cone is numerically a hemisphere): then the sphere is sampled by area.
+/// Written via sin²θmax/(1 + cosθmax) so tiny spheres keep their precision.
+fn sphere_cone_one_minus_cos(s: Sphere, p: vec3<f32>) -> f32 {
+    let d2 = dot(s.center - p, s.center - p);
+    let r2 = s.radius * s.radius;
+    if (!(d2 > r2 * 1.0001)) { return -1.0; }
+    let sin2 = r2 / d2;
+    return sin2 / (1.0 + sqrt(1.0 - sin2));
+}
+
+/// Uniform by area over the whole sphere. Points on the far side face away from p and come back as failed
+/// samples (pdf 0), so the pdf of the successful ones integrates to the visible fraction of the area.
+/// Measure: area → solid angle.
+fn sphere_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+    let s = scene_sphere(prim);
+    let n = square_to_uniform_sphere(u);
+    let y = s.center + s.radius * n;
+    let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
+    let emitted = material_emission(scene_material(s.material), uv);
+    return area_to_solid_angle(p, y, n, 1.0 / (4.0 * PI * s.radius * s.radius), emitted, make_prim(PRIM_SPHERE, prim));
+}
+
+/// Uniform in the subtended cone (solid-angle mode, p outside), else by area.
+fn sphere_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return sphere_sample_area(l.prim, p, u.xy); }
+    let s = scene_sphere(l.prim);
+    let omc = sphere_cone_one_minus_cos(s, p);
+    if (omc <= 0.0) { return sphere_sample_area(l.prim, p, u.xy); }
+    let to_c = s.center - p;
+    let d = length(to_c);
+    let f = frame_from_normal(to_c / d);
+    let wl = square_to_uniform_cone(u.xy, omc);
+    let wi = normalize(to_world(f, wl));
+    // Distance along wi to the near intersection: t = d·cosθ − sqrt(r² − d²·sin²θ). sin²θ from the transverse
+    // components (1 − z² has no digits left in a tiny cone).
+    let sin2 = wl.x * wl.x + wl.y * wl.y;
+    let cos_t = wl.z;
+    let t = max(d * cos_t - safe_sqrt(s.radius * s.radius - d * d * sin2), 0.0);
+    let y = p + t * wi;
+    let n = normalize(y - s.center);
+    let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
+    let emitted = material_emission(scene_material(s.material), uv);
+    return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), MEASURE_SOLID_ANGLE, make_prim(PRIM_SPHERE, l.prim));
+}
+
+fn sphere_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
+    if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE && omc > 0.0) { return 1.0 / (TWO_PI * omc); }
+    // By area: d² / (A·cos_l).
+    let v = y - p;
+    let cos_l = abs(dot(wi, n_y));
+    if (!(cos_l > 0.0)) { return 0.0; }
+    return dot(v, v) / (l.area * cos_l);
+}
+
+fn sphere_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(y); }
+
+// ---- LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL: delta lights (light sampling alone finds them) ----
 
 /// Point light: irradiance-like radiance I/d², pdf 1 (delta).
-fn point_sample_li(l: Light, p: vec3<f32>) -> LightSample {
+fn point_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let v = l.position - p;
     let d2 = dot(v, v);
     if (!(d2 > 0.0)) { return no_light_sample(); }
     let dist = sqrt(d2);
-    return LightSample(v / dist, dist, l.radiance / d2, 1.0, true, -1.0);
+    return LightSample(v / dist, dist, l.radiance / d2, 1.0, MEASURE_DISCRETE, INVALID);
 }
+fn point_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn point_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
 
 /// Spot light: a point light times a smooth falloff between the outer and inner cone.
-fn spot_sample_li(l: Light, p: vec3<f32>) -> LightSample {
-    var s = point_sample_li(l, p);
+fn spot_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+    var s = point_sample_li(l, p, u);
     let c = dot(-s.wi, l.direction);
     s.radiance *= smoothstep(l.cos_outer, l.cos_inner, c);
     return s;
 }
+fn spot_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn spot_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
 
 /// Directional light: light travelling along `direction`, irradiance in `radiance`.
-fn directional_sample_li(l: Light) -> LightSample {
-    return LightSample(-l.direction, F32_MAX, l.radiance, 1.0, true, -1.0);
+fn directional_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+    return LightSample(-l.direction, F32_MAX, l.radiance, 1.0, MEASURE_DISCRETE, INVALID);
 }
+fn directional_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn directional_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
 
-// ---- environment ----
+// ---- LIGHT_ENVIRONMENT: constant or equirectangular, at infinity (a ray that misses everything finds it) ----
 
 /// Direction → equirectangular (u, v) in map space: u = 0.5 looks down −Z, v = 0 is +Y;
 /// the map is rotated by `env_rotation` radians about +Y. θ from atan2 (acos(w.y) loses digits at the poles), and
-/// the accurate atan2 so that directions map to the texels `env_sample_li` sampled them in.
+/// the accurate atan2 so that directions map to the texels `env_sample` sampled them in.
 fn env_direction_to_uv(w: vec3<f32>) -> vec2<f32> {
     let u = atan2_accurate(w.x, -w.z) * INV_TWO_PI + 0.5 - params.env_rotation * INV_TWO_PI;
     return vec2<f32>(fract(u), atan2_accurate(length(w.xz), w.y) * INV_PI);
@@ -309,33 +387,37 @@ fn env_texel_index(uv: vec2<f32>) -> u32 {
     return y * params.env_width + x;
 }
 
+/// Whether the environment is sampled uniformly on the sphere (constant, or by the setting).
+fn env_uniform() -> bool {
+    return ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM;
+}
+
 /// Radiance arriving from direction w (piecewise constant over texels, matching the sampling density).
-fn env_eval(w: vec3<f32>) -> vec3<f32> {
+fn env_radiance(w: vec3<f32>) -> vec3<f32> {
     if (ENV_KIND == 0u) { return vec3<f32>(0.0); }
     if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u)) { return params.env_constant * params.env_scale; }
     return env_texels[env_texel_index(env_direction_to_uv(w))].xyz * params.env_scale;
 }
 
-/// pdf (solid angle) of `env_sample_li` producing w: 1/4π (uniform), or density_uv / (2π² sinθ) (importance).
+/// pdf (solid angle) of `env_sample` producing w: 1/4π (uniform), or density_uv / (2π² sinθ) (importance).
 /// sinθ = |w.xz| (1 − w.y² loses its digits near the poles).
 fn env_pdf(w: vec3<f32>) -> f32 {
     if (ENV_KIND == 0u) { return 0.0; }
-    if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) { return INV_FOUR_PI; }
+    if (env_uniform()) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
     let density_uv = env_texels[env_texel_index(uv)].w;
     let sin_theta = length(w.xz);
     return density_uv / (2.0 * PI * PI * max(sin_theta, 1e-7));
 }
 
-/// Environment: uniform on the sphere, or a texel ∝ luminance·sinθ by the alias table (column from u.z, coin
-/// from u.y, which is then reused) and uniform in (u, v) inside the texel, so pdf_ω = density_uv / (2π² sinθ).
-/// The pdf returned is the chosen texel's: at a texel edge, f32 rounding may map the direction into the
-/// neighbour, where `env_pdf` (and a black neighbour's radiance) would differ on that measure-zero set.
-/// Measure: solid angle.
-fn env_sample_li(u: vec3<f32>) -> LightSample {
-    if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM) {
+/// Uniform on the sphere, or a texel ∝ luminance·sinθ by the alias table (column from u.z, coin from u.y, which is
+/// then reused) and uniform in (u, v) inside the texel, so pdf_ω = density_uv / (2π² sinθ). The pdf returned is
+/// the chosen texel's: at a texel edge, f32 rounding may map the direction into the neighbour, where `env_pdf`
+/// (and a black neighbour's radiance) would differ on that measure-zero set. Measure: solid angle.
+fn env_sample(u: vec3<f32>) -> LightSample {
+    if (env_uniform()) {
         let wi = square_to_uniform_sphere(u.xy);
-        return LightSample(wi, F32_MAX, env_eval(wi), INV_FOUR_PI, false, -1.0);
+        return LightSample(wi, F32_MAX, env_radiance(wi), INV_FOUR_PI, MEASURE_SOLID_ANGLE, INVALID);
     }
     let n = params.env_width * params.env_height;
     let pick = alias_sample2(0u, n, u.z, u.y, true);
@@ -346,98 +428,59 @@ fn env_sample_li(u: vec3<f32>) -> LightSample {
     let texel = env_texels[pick.index];
     let pdf = texel.w / (2.0 * PI * PI * max(length(wi.xz), 1e-7));
     if (!(pdf > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, false, -1.0);
+    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, MEASURE_SOLID_ANGLE, INVALID);
 }
 
-// ---- the light technique as a whole ----
+fn environment_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample { return env_sample(u); }
+fn environment_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return env_pdf(wi); }
+fn environment_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return env_radiance(wi); }
 
-/// Samples a point or direction on light `i` as seen from p (without the selection probability).
+// ---- the dispatchers: one case per kind; a kind the scene lacks is compiled out by its HAS_* constant ----
+
+/// Samples light i as seen from p (without the selection probability).
 fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let l = scene_light(i);
-    let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
     switch (l.kind) {
-        case LIGHT_TRIANGLE: {
-            if (!HAS_TRIANGLE_LIGHTS) { return no_light_sample(); }
-            if (solid_angle) { return triangle_sample_li_solid_angle(l.prim, p, u.xy); }
-            return triangle_sample_li(l.prim, p, u.xy);
-        }
-        case LIGHT_QUAD: {
-            if (!HAS_QUAD_LIGHTS) { return no_light_sample(); }
-            if (solid_angle) { return quad_sample_li_solid_angle(l.prim, p, u.xy); }
-            return quad_sample_li(l.prim, p, u.xy);
-        }
-        case LIGHT_SPHERE: {
-            if (!HAS_SPHERE_LIGHTS) { return no_light_sample(); }
-            if (solid_angle) { return sphere_sample_li_cone(l.prim, p, u.xy); }
-            return sphere_sample_li_area(l.prim, p, u.xy);
-        }
-        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_sample_li(l, p); } }
-        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_sample_li(l, p); } }
-        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_sample_li(l); } }
-        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return env_sample_li(u); } }
+        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_sample_li(l, p, u); } }
+        case LIGHT_SPHERE: { if (HAS_SPHERE_LIGHTS) { return sphere_sample_li(l, p, u); } }
+        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_sample_li(l, p, u); } }
+        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_sample_li(l, p, u); } }
+        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_sample_li(l, p, u); } }
+        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_sample_li(l, p, u); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_sample_li(l, p, u); } }
         default: {}
     }
     return no_light_sample();
 }
 
-/// pdf (solid angle, without selection) that `light_sample_li` for light i produces the point y
-/// (normal n_y, either orientation) seen from p along wi. For the environment y is unused. The fallback
-/// decisions are the samplers' own (`triangle_light_omega`, `quad_light_frame`, `sphere_cone_one_minus_cos`);
-/// a triangle or quad seen from behind has pdf 0 (one-sided emitters).
+/// pdf (solid angle, without selection) that `light_sample_li(i, p, ·)` draws wi, meeting the light at y (n_y).
 fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
     let l = scene_light(i);
-    if (l.kind == LIGHT_ENVIRONMENT) { return env_pdf(wi); }
-    if (l.kind > LIGHT_QUAD) { return 0.0; }
-    return light_pdf_given_omega(i, p, wi, y, n_y, light_omega(i, p));
-}
-
-/// The `omega` of `LightSample` for area light i seen from p: what its sampler decides there.
-fn light_omega(i: u32, p: vec3<f32>) -> f32 {
-    let l = scene_light(i);
-    let solid_angle = cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE;
-    if (HAS_TRIANGLE_LIGHTS && l.kind == LIGHT_TRIANGLE) {
-        let tp = scene_tri_positions(l.prim);
-        if (solid_angle) { return triangle_light_omega(tp.v0, tp.v1, tp.v2, p); }
-        return select(0.0, -1.0, dot(p - tp.v0, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)) > 0.0);
-    }
-    if (HAS_QUAD_LIGHTS && l.kind == LIGHT_QUAD) {
-        let q = scene_quad(l.prim);
-        if (solid_angle) { return quad_light_frame(q, p).rect.omega; }
-        return select(0.0, -1.0, dot(p - q.corner, cross(q.edge_u, q.edge_v)) > 0.0);
-    }
-    if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE) {
-        let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
-        return select(-1.0, TWO_PI * omc, solid_angle && omc > 0.0);
+    switch (l.kind) {
+        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_SPHERE: { if (HAS_SPHERE_LIGHTS) { return sphere_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_pdf_li(l, p, wi, y, n_y); } }
+        default: {}
     }
     return 0.0;
 }
 
-/// `light_pdf_li` for an area light whose `omega` from p is known (a light sample taken at p returns it: the
-/// pdf of a direction that hits the same light from the same point needs no second spherical-polygon setup).
-fn light_pdf_given_omega(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, omega: f32) -> f32 {
-    if (omega > 0.0) { return 1.0 / omega; }
-    if (!(omega < 0.0)) { return 0.0; }
-    // By area: d² / (A·cos_l).
+/// Radiance light i emits along wi from the point y a ray found.
+fn light_eval(i: u32, y: Surface, wi: vec3<f32>) -> vec3<f32> {
     let l = scene_light(i);
-    let v = y - p;
-    let d2 = dot(v, v);
-    if (HAS_TRIANGLE_LIGHTS && l.kind == LIGHT_TRIANGLE) {
-        let tp = scene_tri_positions(l.prim);
-        // (2/|n|)·d² / cos_l with cos_l = |wi·n|/|n|.
-        let c = abs(dot(wi, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)));
-        if (!(c > 0.0)) { return 0.0; }
-        return 2.0 * d2 / c;
+    switch (l.kind) {
+        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_eval(l, y, wi); } }
+        case LIGHT_SPHERE: { if (HAS_SPHERE_LIGHTS) { return sphere_eval(l, y, wi); } }
+        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_eval(l, y, wi); } }
+        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_eval(l, y, wi); } }
+        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_eval(l, y, wi); } }
+        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_eval(l, y, wi); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_eval(l, y, wi); } }
+        default: {}
     }
-    if (HAS_QUAD_LIGHTS && l.kind == LIGHT_QUAD) {
-        let q = scene_quad(l.prim);
-        let c = abs(dot(wi, cross(q.edge_u, q.edge_v)));
-        if (!(c > 0.0)) { return 0.0; }
-        return d2 / c;
-    }
-    if (HAS_SPHERE_LIGHTS && l.kind == LIGHT_SPHERE) {
-        let cos_l = abs(dot(wi, n_y));
-        if (!(cos_l > 0.0)) { return 0.0; }
-        return d2 / (l.area * cos_l);
-    }
-    return 0.0;
+    return vec3<f32>(0.0);
 }

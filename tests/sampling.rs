@@ -148,7 +148,7 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             if (s.pdf > 0.0) { o1.x = bsdf_pdf(probe_bsdf(), p, s.wi); }
         }
         case R_ENV: {
-            let s = env_sample_li(u.xyz);
+            let s = env_sample(u.xyz);
             o0 = vec4<f32>(s.wi, s.pdf);
             if (s.pdf > 0.0) { o1 = vec4<f32>(env_pdf(s.wi), 0.0, luminance(s.radiance), 0.0); }
         }

@@ -44,3 +44,81 @@ fn baked_scene_modules_validate_and_have_their_own_keys() {
     }
     assert_eq!(Features::generic().baked, 0);
 }
+
+/// The light contract (shaders/lights.wgsl's header; docs/adding-a-light.md): every light kind `LIGHT_K` of
+/// common.wgsl has exactly `k_sample_li`, `k_pdf_li` and `k_eval`, each dispatcher has exactly one `case` per kind
+/// calling its function, and nothing else in the shaders names a kind or switches on one. On the Rust side a kind's
+/// tag is named only where the light table is built and where the scene's features are read.
+#[test]
+fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    // WGSL without its comments, so that prose may name kinds freely.
+    let code = |name: &str| -> String {
+        let text = std::fs::read_to_string(dir.join("shaders").join(name)).unwrap();
+        text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n")
+    };
+    let common = code("common.wgsl");
+    let kinds: Vec<String> = common
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("const LIGHT_"))
+        .map(|l| l.split(':').next().unwrap().to_string())
+        .filter(|k| !k.starts_with("SAMPLING_") && !k.starts_with("SELECT_"))
+        .collect();
+    assert!(kinds.len() >= 7, "light kinds in common.wgsl: {kinds:?}");
+    let lights = code("lights.wgsl");
+    let count = |hay: &str, needle: &str| hay.matches(needle).count();
+    // The body of `fn name(`, up to the next top-level `fn`.
+    let body = |name: &str| -> String {
+        let start = lights.find(&format!("fn {name}(")).unwrap_or_else(|| panic!("no dispatcher {name}"));
+        let rest = &lights[start + 3..];
+        rest[..rest.find("\nfn ").unwrap_or(rest.len())].to_string()
+    };
+    let ops = [("light_sample_li", "sample_li"), ("light_pdf_li", "pdf_li"), ("light_eval", "eval")];
+    for k in &kinds {
+        let lower = k.to_lowercase();
+        for (dispatcher, op) in ops {
+            let f = format!("{lower}_{op}(");
+            assert_eq!(count(&lights, &format!("fn {f}")), 1, "lights.wgsl must define {f}…) once");
+            let b = body(dispatcher);
+            assert_eq!(count(&b, &format!("case LIGHT_{k}:")), 1, "{dispatcher} needs one case LIGHT_{k}");
+            assert_eq!(count(&b, &f), 1, "{dispatcher}'s case LIGHT_{k} must call {f}…)");
+        }
+    }
+    // Nothing else names a kind or switches on one: each kind's tag appears in the shaders only in its three cases
+    // (and its definition), and `.kind` is read only by the three dispatchers.
+    let mut all = String::new();
+    for (name, _) in mislab::shaders::FILES {
+        if *name != "common.wgsl" {
+            all += &code(name);
+        }
+    }
+    for k in &kinds {
+        assert_eq!(count(&all, &format!("LIGHT_{k}")), 3, "LIGHT_{k} is named outside the light dispatchers");
+    }
+    assert_eq!(count(&all, ".kind"), 3, "something besides the three dispatchers reads a light's kind");
+    // Rust: the tag is defined in gpu_types.rs, turned into table entries in gpu_scene.rs and into HAS_* flags in
+    // features.rs, and named in no other file of src/.
+    let mut files = Vec::new();
+    let mut stack = vec![dir.join("src")];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                files.push(p);
+            }
+        }
+    }
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let name = f.file_name().unwrap().to_str().unwrap();
+        if kinds.iter().any(|k| text.contains(&format!("LIGHT_{k}"))) {
+            assert!(
+                ["gpu_types.rs", "gpu_scene.rs", "features.rs"].contains(&name),
+                "{} names a light kind: adding one would have to touch it too",
+                f.display()
+            );
+        }
+    }
+}
