@@ -3,7 +3,7 @@
 //   * direction techniques (uniform hemisphere, cosine hemisphere, BSDF): sample w, trace, find emitters;
 //   * light techniques (lights.wgsl): sample a point/direction on an emitter, test a shadow ray.
 // `--strategy` picks which run; `mis` runs both and weights them (multi-sample or one-sample MIS). The first
-// direction sample is also the path's continuation: shade() returns it untraced, and the path loop
+// direction sample is also the path's continuation: in path mode shade() returns it untraced, and the path loop
 // (integrator.wgsl) traces it once, for the next vertex and the emission it finds there alike.
 
 /// The shading point as the techniques see it.
@@ -98,25 +98,23 @@ fn mis_on() -> bool { return cfg_strategy() == STRATEGY_MIS; }
 // Each technique's sample is weighted against the other's pdf of the same direction, with the sample counts
 // n_l = --light-samples and n_d = --bsdf-samples.
 
-/// A light-technique sample's estimate, and what the sample was (its measure and pdf, for `found_emission`).
+/// A light-technique sample's estimate, and how its light is sampled from the shading point.
 struct LightEstimate {
     radiance: vec3<f32>,
-    measure: u32,
-    pdf: f32,
+    m: LightMeasure,
 }
 
 /// Block 1, the light technique: choose a light, sample it, test visibility, weight against the direction
 /// technique's pdf. L·f·cos / (pmf·pdf).
 fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
-    var out = LightEstimate(vec3<f32>(0.0), MEASURE_NONE, 0.0);
+    var out = LightEstimate(vec3<f32>(0.0), LightMeasure(MEASURE_NONE, 0.0));
     if (params.num_lights == 0u) { return out; }
     let base = dim_base(c.bounce, j);
     let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT));
     let pmf = light_pmf(li);
     let u = vec3<f32>(sample_2d(c.id, base + DIM_LIGHT_UV), sample_1d(c.id, base + DIM_LIGHT_EXTRA));
     let ls = light_sample_li(li, c.x.p, u);
-    out.measure = ls.measure;
-    out.pdf = ls.pdf;
+    out.m = ls.m;
     if (!(ls.pdf > 0.0) || !(pmf > 0.0)) { return out; }
     // Reflection only: the light must be above both the shading and the geometric hemisphere.
     let cos_s = dot(ls.wi, c.x.ns);
@@ -126,61 +124,59 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     if (all(f * ls.radiance == vec3<f32>(0.0)) || !unoccluded(c.x, ls)) { return out; }
     let p_light = pmf * ls.pdf;
     var w = 1.0;
-    if (mis_on() && ls.measure != MEASURE_DISCRETE) {
+    if (mis_on() && ls.m.measure != MEASURE_DISCRETE) {
         w = mis_weight(f32(params.light_samples), p_light, f32(params.bsdf_samples), direction_pdf(c, wi));
     }
     out.radiance = w * ls.radiance * f * cos_s / p_light;
     return out;
 }
 
-/// Block 2, the direction technique: the weight of emission found along a direction it sampled with pdf p_dir,
-/// against the light technique's pdf p_light of that direction (selection included, from `found_emission`).
-fn direction_mis_weight(p_dir: f32, p_light: f32) -> f32 {
-    if (!mis_on()) { return 1.0; }
-    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), p_light);
-}
-
-/// What a traced direction found: emitted radiance, the light technique's pdf of it (with selection), and the
-/// shading point there (the path's next vertex).
+/// What a traced direction found: the emitted radiance arriving along it, the light that emits it (INVALID: none)
+/// and the shading point there (the path's next vertex; unset for a miss).
 struct Found {
     le: vec3<f32>,
-    p_light: f32,
+    light: u32,
     surface: Surface,
 }
 
-/// Whether a vertex's first light sample serves the pdf of any light its direction samples hit: one light (so the
-/// hit is the one sampled), drawn uniformly in solid angle (so its pdf is every direction's). Saves a second
-/// spherical-polygon setup per vertex.
-fn light_pdf_reusable(known: LightEstimate) -> bool {
-    return !MANY_LIGHTS && known.measure == MEASURE_SOLID_ANGLE;
-}
-
-/// What the ray o + t·w leaving the shading point `from_p` found at `hit`; `known` is the first light sample
-/// taken at from_p (MEASURE_NONE: none).
-fn found_emission(from_p: vec3<f32>, o: vec3<f32>, w: vec3<f32>, hit: Hit, known: LightEstimate) -> Found {
+/// What the ray o + t·w found at `hit`: a surface (an area light's eval there) or, for a miss, the environment.
+fn found_emission(o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
     var r: Found;
     r.le = vec3<f32>(0.0);
-    r.p_light = 0.0;
+    r.light = INVALID;
     if (hit.prim == INVALID) {
-        // A miss finds the environment (at infinity: nothing to set up, so no reuse).
-        if (params.env_light != INVALID) {
-            r.le = env_radiance(w);
-            r.p_light = light_pmf(params.env_light) * env_pdf(w);
-        }
+        r.light = params.env_light;
+        if (r.light != INVALID) { r.le = env_radiance(w); }
         return r;
     }
-    let y = surface_at(hit, o, w);
-    r.surface = y;
-    if (y.light == INVALID) { return r; }
-    r.le = light_eval(y.light, y, w);
-    if (all(r.le == vec3<f32>(0.0))) { return r; }
-    // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
-    if (light_pdf_reusable(known)) {
-        r.p_light = light_pmf(y.light) * known.pdf;
-    } else {
-        r.p_light = light_pmf(y.light) * light_pdf_li(y.light, from_p, w, y.p, y.ng);
-    }
+    r.surface = surface_at(hit, o, w);
+    r.light = r.surface.light;
+    if (r.light != INVALID) { r.le = light_eval(r.light, r.surface, w); }
     return r;
+}
+
+/// Whether the measure of the first light sample at a shading point is that of any light its direction samples
+/// hit: one light (the one sampled), sampled at every vertex (not one-sample MIS). Saves a second
+/// spherical-polygon setup per vertex. Fixed per pipeline.
+fn light_measure_known() -> bool {
+    return !MANY_LIGHTS && cfg_mis_kind() == MIS_MULTI;
+}
+
+/// Block 2, the direction technique: the MIS weight of emission `found` along w, a direction it sampled from the
+/// shading point `from_p` with pdf p_dir, against the light technique's pdf of w (selection included). `known`:
+/// the measure of the first light sample taken at from_p.
+fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, w: vec3<f32>, known: LightMeasure) -> f32 {
+    if (!mis_on()) { return 1.0; }
+    var p_light = 0.0;
+    if (found.light == params.env_light) {
+        p_light = env_pdf(w);
+    } else {
+        var m = known;
+        if (!light_measure_known()) { m = light_measure(found.light, from_p); }
+        // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
+        p_light = light_pdf_li(found.light, m, from_p, w, found.surface.p, found.surface.ng);
+    }
+    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(found.light) * p_light);
 }
 
 // ---- shade() ----
@@ -214,11 +210,11 @@ fn strategy_plan(c: ShadingCtx) -> Plan {
     return p;
 }
 
-/// What shade() returns: the estimate it completed, and direction sample 0 untraced — the path's continuation,
-/// whose emission the caller counts where its trace finds it: × next_scale × direction_mis_weight(next_pdf, ·).
+/// What shade() returns: the estimate it completed, and (path mode) direction sample 0 untraced — the path's
+/// continuation, whose emission the caller counts where its trace finds it, × next_scale × direction_mis_weight.
 struct Shaded {
-    radiance: vec3<f32>,      // light samples and direction samples 1.., weighted
-    light: LightEstimate,     // the first light sample (for found_emission at the next vertex)
+    radiance: vec3<f32>,      // light samples and the direction samples traced here, weighted
+    light: LightMeasure,      // the first light sample's (for direction_mis_weight at the next vertex)
     next_valid: bool,
     next_origin: vec3<f32>,
     next_dir: vec3<f32>,
@@ -234,28 +230,32 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     var out: Shaded;
     let plan = strategy_plan(c);
     out.radiance = vec3<f32>(0.0);
-    out.light = LightEstimate(vec3<f32>(0.0), MEASURE_NONE, 0.0);
+    out.light = LightMeasure(MEASURE_NONE, 0.0);
     for (var j = 0u; j < min(plan.light_runs, 64u); j += 1u) {
         let e = light_technique(c, j);
         out.radiance += e.radiance / plan.light_div;
-        if (j == 0u) { out.light = e; }
+        if (j == 0u) { out.light = e.m; }
     }
-    // Direction samples 1.. (--bsdf-samples > 1) are traced here; a pipeline for one sample compiles none.
-    if (SPEC_ONE_DIRECTION != 1u) {
-        for (var j = 1u; j < min(plan.dir_runs, 64u); j += 1u) {
+    // Direction samples 1.. (--bsdf-samples > 1) are traced here; a pipeline for one sample compiles none. In direct
+    // mode sample 0 is traced here too: there is no path to continue, and one trace site (this one) per sample keeps
+    // a direct sample to one pass of the path loop (measured ~7 % faster on veach-mis than two).
+    let all_here = cfg_mode() == MODE_DIRECT;
+    if (SPEC_ONE_DIRECTION != 1u || all_here) {
+        for (var j = select(1u, 0u, all_here); j < min(plan.dir_runs, 64u); j += 1u) {
             let ds = direction_sample(c, j);
             if (!(ds.w > 0.0)) { continue; }
             let w = to_world(c.frame, ds.xyz);
             if (dot(w, c.x.ng) <= 0.0) { continue; }
             let o = spawn_origin(c.x, w);
             rays_traced += 1u;
-            let found = found_emission(c.x.p, o, w, trace_closest(o, w, F32_MAX), out.light);
-            let f_cos = bsdf_eval(c.brdf, c.wo, ds.xyz) * ds.z / ds.w;
-            out.radiance += f_cos * (direction_mis_weight(ds.w, found.p_light) * plan.dir_scale * found.le);
+            let found = found_emission(o, w, trace_closest(o, w, F32_MAX));
+            if (all(found.le == vec3<f32>(0.0))) { continue; }
+            let f = bsdf_eval(c.brdf, c.wo, ds.xyz);
+            out.radiance += direction_mis_weight(ds.w, found, c.x.p, w, out.light) * found.le * f * ds.z / ds.w * plan.dir_scale;
         }
     }
     out.next_valid = false;
-    if (!want_next && plan.dir_runs == 0u) { return out; }
+    if (all_here || (!want_next && plan.dir_runs == 0u)) { return out; }
     let ds = direction_sample(c, 0u);
     if (!(ds.w > 0.0)) { return out; }
     let w = to_world(c.frame, ds.xyz);

@@ -1,26 +1,38 @@
 // lights.wgsl — the light techniques, one section per light kind, and light selection.
 //
-// Contract (pbrt-v4's Light::SampleLi / PDF_Li / L). Every kind K (`LIGHT_K` in common.wgsl) has one section with:
+// Contract (pbrt-v4's Light::SampleLi / PDF_Li / L, plus the measure they share). Every kind K (`LIGHT_K` in
+// common.wgsl) has one section with:
+//   K_measure(l, p) -> LightMeasure       how K_sample_li draws directions from p (by area, uniformly in the solid
+//                                         angle the light subtends, a delta, none): decided once, so that sample_li
+//                                         and pdf_li agree, and kept by a caller that needs the pdf again;
 //   K_sample_li(l, p, u) -> LightSample   a direction wi from p towards light l, drawn with u ∈ [0,1)³: the
 //                                         distance to the light point, the radiance arriving along wi unoccluded
 //                                         (delta lights: intensity/d² or irradiance), its pdf per unit solid angle
-//                                         at p (0 = no sample) and the measure it was drawn in;
-//   K_pdf_li(l, p, wi, y, n_y) -> f32     the pdf per unit solid angle that K_sample_li draws wi, which meets the
-//                                         light at y with geometric normal n_y (either orientation); 0 for delta
-//                                         lights;
+//                                         at p (0 = no sample), and K_measure(l, p) (also when the sample failed);
+//   K_pdf_li(l, m, p, wi, y, n_y) -> f32  the pdf per unit solid angle that K_sample_li draws wi, which meets the
+//                                         light at y with geometric normal n_y (either orientation), given
+//                                         m = K_measure(l, p); 0 for delta lights;
 //   K_eval(l, y, wi) -> vec3<f32>         the radiance the light emits along wi from the point y a ray found (the
 //                                         environment ignores y); 0 for delta lights, which no ray finds.
 // No pdf here includes the selection probability (`light_pmf`). Emitters are one-sided: from behind a triangle
-// or quad, p gets no light and pdf_li is 0. The dispatchers light_sample_li / light_pdf_li / light_eval (last
-// section) have one `case` per kind; tests/shaders.rs checks that and that nothing else switches on the kind.
+// or quad, p gets no light (MEASURE_NONE) and pdf_li is 0. The dispatchers light_measure / light_sample_li /
+// light_pdf_li / light_eval (last section) have one `case` per kind; tests/shaders.rs checks that and that nothing
+// else switches on the kind.
 
-/// The measure a light sample was drawn in. For an area light MEASURE_SOLID_ANGLE is uniform in the solid angle it
-/// subtends (spherical triangle, spherical rectangle, cone), so its pdf holds for every direction that meets the
-/// light from the same p; MEASURE_AREA is uniform by area, converted per direction by d²/cos.
+/// How a light's sampler draws directions from a point p. MEASURE_SOLID_ANGLE: uniformly in the solid angle
+/// `omega` the light subtends (spherical triangle, spherical rectangle, cone), so pdf = 1/omega for every
+/// direction that meets it; the environment draws per texel, in solid angle too (`omega` unused). MEASURE_AREA:
+/// uniformly by area, converted per direction by d²/cos. MEASURE_DISCRETE: a delta light. MEASURE_NONE: p gets no
+/// light from it.
 const MEASURE_NONE: u32 = 0u;
 const MEASURE_SOLID_ANGLE: u32 = 1u;
 const MEASURE_AREA: u32 = 2u;
 const MEASURE_DISCRETE: u32 = 3u;
+
+struct LightMeasure {
+    measure: u32,
+    omega: f32,
+}
 
 /// A sampled direction towards a light (see the contract above). `prim` is the light's own primitive reference,
 /// which a shadow ray towards it must not count as an occluder (INVALID for delta and environment lights).
@@ -29,12 +41,19 @@ struct LightSample {
     dist: f32,
     radiance: vec3<f32>,
     pdf: f32,
-    measure: u32,
+    m: LightMeasure,
     prim: u32,
 }
 
 fn no_light_sample() -> LightSample {
-    return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, MEASURE_NONE, INVALID);
+    return LightSample(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), 0.0, LightMeasure(MEASURE_NONE, 0.0), INVALID);
+}
+
+/// A failed sample that keeps the measure decided at p.
+fn no_light_sample_in(m: LightMeasure) -> LightSample {
+    var s = no_light_sample();
+    s.m = m;
+    return s;
 }
 
 // ---- light selection ----
@@ -84,7 +103,7 @@ fn select_light(u: f32) -> u32 {
 //
 // By area: uniform on the surface, converted to solid angle by d²/cos. By solid angle (spherical triangle,
 // spherical rectangle, cone) where the warp is accurate, else by area: that choice is a deterministic function
-// of (light, p), made by one function per kind (`*_measure`) that sample_li and pdf_li share. The spherical warps
+// of (light, p), made by the kind's `*_measure`, which sample_li and pdf_li share. The spherical warps
 // are used only where their f32 error on this platform stays below 1e-4 — sample positions in units of the
 // light's size and Ω relative, against f64 twins, over far / close (above the centre, an edge, a vertex) /
 // grazing viewpoints of regular and 100:1 sliver shapes (tests/sampling.rs `spherical_warps_precision`; the table
@@ -103,13 +122,6 @@ const SPHERICAL_RECT_MAX_SR: f32 = 5.5;
 /// sampled by area in either mode.
 const RECT_COS_TOLERANCE: f32 = 1e-5;
 
-/// How an area light's sampler draws directions from p: MEASURE_NONE (p sees its back: no light), MEASURE_AREA,
-/// or MEASURE_SOLID_ANGLE over the solid angle `omega`.
-struct AreaMeasure {
-    measure: u32,
-    omega: f32,
-}
-
 /// Area-to-solid-angle conversion for a sampled light point y with normal n_y, seen from p.
 /// One-sided: a point seen from behind has pdf 0 (it emits nothing towards p).
 fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32, emitted: vec3<f32>, prim: u32) -> LightSample {
@@ -119,7 +131,7 @@ fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32
     let wi = v / dist;
     let cos_l = dot(-wi, n_y);
     if (!(cos_l > 0.0) || !(d2 > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, MEASURE_AREA, prim);
+    return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, LightMeasure(MEASURE_AREA, 0.0), prim);
 }
 
 /// The emission of an area light at the point y a ray found: its material's, on the front face only.
@@ -131,16 +143,21 @@ fn area_eval(y: Surface) -> vec3<f32> {
 // ---- LIGHT_TRIANGLE: a mesh triangle of an emissive material ----
 
 /// Spherical-triangle sampling where accurate (solid-angle mode), else by area; NONE when p sees the back.
-fn triangle_measure(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32>) -> AreaMeasure {
+fn triangle_measure_of(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32>) -> LightMeasure {
     let n = cross(v1 - v0, v2 - v0);
-    if (!(dot(p - v0, n) > 0.0)) { return AreaMeasure(MEASURE_NONE, 0.0); }
+    if (!(dot(p - v0, n) > 0.0)) { return LightMeasure(MEASURE_NONE, 0.0); }
     if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE) {
         let omega = spherical_triangle_solid_angle(v0 - p, v1 - p, v2 - p);
         if (omega >= SPHERICAL_TRIANGLE_MIN_SR && omega <= SPHERICAL_TRIANGLE_MAX_SR) {
-            return AreaMeasure(MEASURE_SOLID_ANGLE, omega);
+            return LightMeasure(MEASURE_SOLID_ANGLE, omega);
         }
     }
-    return AreaMeasure(MEASURE_AREA, 0.0);
+    return LightMeasure(MEASURE_AREA, 0.0);
+}
+
+fn triangle_measure(l: Light, p: vec3<f32>) -> LightMeasure {
+    let tp = scene_tri_positions(l.prim);
+    return triangle_measure_of(tp.v0, tp.v1, tp.v2, p);
 }
 
 /// Uniform by area (barycentrics by Heitz's low-distortion map). Measure: area → solid angle.
@@ -159,19 +176,21 @@ fn triangle_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
 
 /// Uniform in solid angle (spherical triangle, Arvo 1995) where `triangle_measure` allows, else by area.
 fn triangle_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return triangle_sample_area(l.prim, p, u.xy); }
     let tp = scene_tri_positions(l.prim);
     let v0 = tp.v0;
     let v1 = tp.v1;
     let v2 = tp.v2;
-    let m = triangle_measure(v0, v1, v2, p);
-    if (m.measure == MEASURE_NONE) { return no_light_sample(); }
-    if (m.measure == MEASURE_AREA) { return triangle_sample_area(l.prim, p, u.xy); }
+    let m = triangle_measure_of(v0, v1, v2, p);
+    if (m.measure != MEASURE_SOLID_ANGLE) {
+        var s = triangle_sample_area(l.prim, p, u.xy);
+        s.m = m;
+        return s;
+    }
     let wi = spherical_triangle_warp(u.xy, v0 - p, v1 - p, v2 - p, m.omega);
     // The light point: wi meets the triangle's plane at t = (v0 − p)·n / (wi·n).
     let n = cross(v1 - v0, v2 - v0);
     let t = dot(v0 - p, n) / dot(wi, n);
-    if (!(t > 0.0) || is_nonfinite(t)) { return no_light_sample(); }
+    if (!(t > 0.0) || is_nonfinite(t)) { return no_light_sample_in(m); }
     let y = p + t * wi;
     let inv_nn = 1.0 / dot(n, n);
     let b1 = clamp(dot(cross(y - v0, v2 - v0), n) * inv_nn, 0.0, 1.0);
@@ -179,15 +198,14 @@ fn triangle_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let sh = scene_tri_shading(l.prim);
     let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
     let emitted = material_emission(scene_material(sh.material), uv);
-    return LightSample(wi, t, emitted, 1.0 / m.omega, MEASURE_SOLID_ANGLE, make_prim(PRIM_TRIANGLE, l.prim));
+    return LightSample(wi, t, emitted, 1.0 / m.omega, m, make_prim(PRIM_TRIANGLE, l.prim));
 }
 
-fn triangle_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
-    let tp = scene_tri_positions(l.prim);
-    let m = triangle_measure(tp.v0, tp.v1, tp.v2, p);
+fn triangle_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
     if (m.measure == MEASURE_SOLID_ANGLE) { return 1.0 / m.omega; }
-    if (m.measure == MEASURE_NONE) { return 0.0; }
+    if (m.measure != MEASURE_AREA) { return 0.0; }
     // By area: (2/|n|)·d² / cos_l with cos_l = |wi·n|/|n|.
+    let tp = scene_tri_positions(l.prim);
     let v = y - p;
     let c = abs(dot(wi, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)));
     if (!(c > 0.0)) { return 0.0; }
@@ -198,10 +216,10 @@ fn triangle_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area
 
 // ---- LIGHT_QUAD: an emissive parallelogram ----
 
-/// A quad light seen from p: how it is sampled (`measure`, and for solid angle the spherical rectangle `rect`),
-/// with its unit edges x, y, front normal z and edge lengths.
+/// A quad light seen from p: how it is sampled (`m`, and for solid angle the spherical rectangle `rect`), with
+/// its unit edges x, y, front normal z and edge lengths.
 struct QuadLightFrame {
-    measure: u32,
+    m: LightMeasure,
     x: vec3<f32>,
     y: vec3<f32>,
     z: vec3<f32>,
@@ -212,13 +230,13 @@ struct QuadLightFrame {
 
 /// Spherical-rectangle sampling where accurate (a rectangle, solid-angle mode), else by area; NONE when p sees the
 /// back. The frame is set up only for solid angle.
-fn quad_measure(q: Quad, p: vec3<f32>) -> QuadLightFrame {
+fn quad_frame(q: Quad, p: vec3<f32>) -> QuadLightFrame {
     var f: QuadLightFrame;
-    f.measure = MEASURE_NONE;
+    f.m = LightMeasure(MEASURE_NONE, 0.0);
     let c = cross(q.edge_u, q.edge_v);
     let d = q.corner - p;
     if (!(dot(-d, c) > 0.0)) { return f; }
-    f.measure = MEASURE_AREA;
+    f.m.measure = MEASURE_AREA;
     if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return f; }
     f.lu = length(q.edge_u);
     f.lv = length(q.edge_v);
@@ -228,11 +246,13 @@ fn quad_measure(q: Quad, p: vec3<f32>) -> QuadLightFrame {
     f.z = normalize(c);
     let r = spherical_rect_setup(dot(d, f.x), dot(d, f.y), f.lu, f.lv, -dot(d, f.z));
     if (r.omega >= SPHERICAL_RECT_MIN_SR && r.omega <= SPHERICAL_RECT_MAX_SR) {
-        f.measure = MEASURE_SOLID_ANGLE;
+        f.m = LightMeasure(MEASURE_SOLID_ANGLE, r.omega);
         f.rect = r;
     }
     return f;
 }
+
+fn quad_measure(l: Light, p: vec3<f32>) -> LightMeasure { return quad_frame(scene_quad(l.prim), p).m; }
 
 /// Uniform by area. Measure: area → solid angle.
 fn quad_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
@@ -245,27 +265,28 @@ fn quad_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
     return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted, make_prim(PRIM_QUAD, prim));
 }
 
-/// Uniform in solid angle (spherical rectangle, Ureña et al. 2013) where `quad_measure` allows, else by area.
+/// Uniform in solid angle (spherical rectangle, Ureña et al. 2013) where `quad_frame` allows, else by area.
 fn quad_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return quad_sample_area(l.prim, p, u.xy); }
     let q = scene_quad(l.prim);
-    let f = quad_measure(q, p);
-    if (f.measure == MEASURE_NONE) { return no_light_sample(); }
-    if (f.measure == MEASURE_AREA) { return quad_sample_area(l.prim, p, u.xy); }
+    let f = quad_frame(q, p);
+    if (f.m.measure != MEASURE_SOLID_ANGLE) {
+        var s = quad_sample_area(l.prim, p, u.xy);
+        s.m = f.m;
+        return s;
+    }
     let xy = square_to_spherical_rectangle(u.xy, f.rect);
     let v = xy.x * f.x + xy.y * f.y - f.rect.h * f.z;
     let dist = length(v);
     let st = vec2<f32>((xy.x - f.rect.x0) / f.lu, (xy.y - f.rect.y0) / f.lv);
     let emitted = material_emission(scene_material(q.material), st);
-    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, MEASURE_SOLID_ANGLE, make_prim(PRIM_QUAD, l.prim));
+    return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, f.m, make_prim(PRIM_QUAD, l.prim));
 }
 
-fn quad_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
-    let q = scene_quad(l.prim);
-    let f = quad_measure(q, p);
-    if (f.measure == MEASURE_SOLID_ANGLE) { return 1.0 / f.rect.omega; }
-    if (f.measure == MEASURE_NONE) { return 0.0; }
+fn quad_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    if (m.measure == MEASURE_SOLID_ANGLE) { return 1.0 / m.omega; }
+    if (m.measure != MEASURE_AREA) { return 0.0; }
     // By area: d² / (A·cos_l) = d² / |wi·(edge_u × edge_v)|.
+    let q = scene_quad(l.prim);
     let v = y - p;
     let c = abs(dot(wi, cross(q.edge_u, q.edge_v)));
     if (!(c > 0.0)) { return 0.0; }
@@ -300,11 +321,28 @@ fn sphere_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
 }
 
 /// Uniform in the subtended cone (solid-angle mode, p outside), else by area.
+fn sphere_measure(l: Light, p: vec3<f32>) -> LightMeasure {
+    let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
+    if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE && omc > 0.0) {
+        return LightMeasure(MEASURE_SOLID_ANGLE, TWO_PI * omc);
+    }
+    return LightMeasure(MEASURE_AREA, 0.0);
+}
+
 fn sphere_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return sphere_sample_area(l.prim, p, u.xy); }
+    // A far-side point of the area sampler fails, but keeps the measure: other directions from p do meet the light.
+    if (cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) {
+        var a = sphere_sample_area(l.prim, p, u.xy);
+        a.m = LightMeasure(MEASURE_AREA, 0.0);
+        return a;
+    }
     let s = scene_sphere(l.prim);
     let omc = sphere_cone_one_minus_cos(s, p);
-    if (omc <= 0.0) { return sphere_sample_area(l.prim, p, u.xy); }
+    if (omc <= 0.0) {
+        var a = sphere_sample_area(l.prim, p, u.xy);
+        a.m = LightMeasure(MEASURE_AREA, 0.0);
+        return a;
+    }
     let to_c = s.center - p;
     let d = length(to_c);
     let f = frame_from_normal(to_c / d);
@@ -319,12 +357,12 @@ fn sphere_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let n = normalize(y - s.center);
     let uv = vec2<f32>(atan2(n.z, n.x) * INV_TWO_PI + 0.5, acos(clamp(n.y, -1.0, 1.0)) * INV_PI);
     let emitted = material_emission(scene_material(s.material), uv);
-    return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), MEASURE_SOLID_ANGLE, make_prim(PRIM_SPHERE, l.prim));
+    let m = LightMeasure(MEASURE_SOLID_ANGLE, TWO_PI * omc);
+    return LightSample(wi, t, emitted, square_to_uniform_cone_pdf(omc), m, make_prim(PRIM_SPHERE, l.prim));
 }
 
-fn sphere_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
-    let omc = sphere_cone_one_minus_cos(scene_sphere(l.prim), p);
-    if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE && omc > 0.0) { return 1.0 / (TWO_PI * omc); }
+fn sphere_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    if (m.measure == MEASURE_SOLID_ANGLE) { return 1.0 / m.omega; }
     // By area: d² / (A·cos_l).
     let v = y - p;
     let cos_l = abs(dot(wi, n_y));
@@ -342,9 +380,10 @@ fn point_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let d2 = dot(v, v);
     if (!(d2 > 0.0)) { return no_light_sample(); }
     let dist = sqrt(d2);
-    return LightSample(v / dist, dist, l.radiance / d2, 1.0, MEASURE_DISCRETE, INVALID);
+    return LightSample(v / dist, dist, l.radiance / d2, 1.0, LightMeasure(MEASURE_DISCRETE, 0.0), INVALID);
 }
-fn point_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn point_measure(l: Light, p: vec3<f32>) -> LightMeasure { return LightMeasure(MEASURE_DISCRETE, 0.0); }
+fn point_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
 fn point_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
 
 /// Spot light: a point light times a smooth falloff between the outer and inner cone.
@@ -354,14 +393,16 @@ fn spot_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     s.radiance *= smoothstep(l.cos_outer, l.cos_inner, c);
     return s;
 }
-fn spot_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn spot_measure(l: Light, p: vec3<f32>) -> LightMeasure { return LightMeasure(MEASURE_DISCRETE, 0.0); }
+fn spot_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
 fn spot_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
 
 /// Directional light: light travelling along `direction`, irradiance in `radiance`.
 fn directional_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    return LightSample(-l.direction, F32_MAX, l.radiance, 1.0, MEASURE_DISCRETE, INVALID);
+    return LightSample(-l.direction, F32_MAX, l.radiance, 1.0, LightMeasure(MEASURE_DISCRETE, 0.0), INVALID);
 }
-fn directional_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn directional_measure(l: Light, p: vec3<f32>) -> LightMeasure { return LightMeasure(MEASURE_DISCRETE, 0.0); }
+fn directional_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
 fn directional_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
 
 // ---- LIGHT_ENVIRONMENT: constant or equirectangular, at infinity (a ray that misses everything finds it) ----
@@ -417,7 +458,7 @@ fn env_pdf(w: vec3<f32>) -> f32 {
 fn env_sample(u: vec3<f32>) -> LightSample {
     if (env_uniform()) {
         let wi = square_to_uniform_sphere(u.xy);
-        return LightSample(wi, F32_MAX, env_radiance(wi), INV_FOUR_PI, MEASURE_SOLID_ANGLE, INVALID);
+        return LightSample(wi, F32_MAX, env_radiance(wi), INV_FOUR_PI, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
     }
     let n = params.env_width * params.env_height;
     let pick = alias_sample2(0u, n, u.z, u.y, true);
@@ -428,11 +469,14 @@ fn env_sample(u: vec3<f32>) -> LightSample {
     let texel = env_texels[pick.index];
     let pdf = texel.w / (2.0 * PI * PI * max(length(wi.xz), 1e-7));
     if (!(pdf > 0.0)) { return no_light_sample(); }
-    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, MEASURE_SOLID_ANGLE, INVALID);
+    return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
 }
 
 fn environment_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample { return env_sample(u); }
-fn environment_pdf_li(l: Light, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return env_pdf(wi); }
+fn environment_measure(l: Light, p: vec3<f32>) -> LightMeasure { return LightMeasure(MEASURE_SOLID_ANGLE, 0.0); }
+fn environment_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    return env_pdf(wi);
+}
 fn environment_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return env_radiance(wi); }
 
 // ---- the dispatchers: one case per kind; a kind the scene lacks is compiled out by its HAS_* constant ----
@@ -453,17 +497,34 @@ fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     return no_light_sample();
 }
 
-/// pdf (solid angle, without selection) that `light_sample_li(i, p, ·)` draws wi, meeting the light at y (n_y).
-fn light_pdf_li(i: u32, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+/// How light i is sampled from p.
+fn light_measure(i: u32, p: vec3<f32>) -> LightMeasure {
     let l = scene_light(i);
     switch (l.kind) {
-        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_pdf_li(l, p, wi, y, n_y); } }
-        case LIGHT_SPHERE: { if (HAS_SPHERE_LIGHTS) { return sphere_pdf_li(l, p, wi, y, n_y); } }
-        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_pdf_li(l, p, wi, y, n_y); } }
-        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_pdf_li(l, p, wi, y, n_y); } }
-        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_pdf_li(l, p, wi, y, n_y); } }
-        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_pdf_li(l, p, wi, y, n_y); } }
-        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_pdf_li(l, p, wi, y, n_y); } }
+        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_measure(l, p); } }
+        case LIGHT_SPHERE: { if (HAS_SPHERE_LIGHTS) { return sphere_measure(l, p); } }
+        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_measure(l, p); } }
+        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_measure(l, p); } }
+        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_measure(l, p); } }
+        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_measure(l, p); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_measure(l, p); } }
+        default: {}
+    }
+    return LightMeasure(MEASURE_NONE, 0.0);
+}
+
+/// pdf (solid angle, without selection) that `light_sample_li(i, p, ·)` draws wi, meeting the light at y (n_y), given
+/// m = light_measure(i, p).
+fn light_pdf_li(i: u32, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    let l = scene_light(i);
+    switch (l.kind) {
+        case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_SPHERE: { if (HAS_SPHERE_LIGHTS) { return sphere_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_QUAD: { if (HAS_QUAD_LIGHTS) { return quad_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_pdf_li(l, m, p, wi, y, n_y); } }
         default: {}
     }
     return 0.0;

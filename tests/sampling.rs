@@ -139,7 +139,7 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             o0 = vec4<f32>(s.wi, s.pdf);
             if (s.pdf > 0.0) {
                 let y = p + s.dist * s.wi;
-                o1 = vec4<f32>(light_pdf_li(probe_job.light, p, s.wi, y, probe_light_normal(probe_job.light, y)), s.dist, luminance(s.radiance), 0.0);
+                o1 = vec4<f32>(light_pdf_li(probe_job.light, light_measure(probe_job.light, p), p, s.wi, y, probe_light_normal(probe_job.light, y)), s.dist, luminance(s.radiance), 0.0);
             }
         }
         case R_BSDF: {
@@ -186,7 +186,7 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         case R_UNIFORM_SPHERE: { pdf = square_to_uniform_sphere_pdf(); }
         case R_CONE: { if (w.w != 0.0) { pdf = square_to_uniform_cone_pdf(probe_job.a.x); } }
         case R_LIGHT: {
-            if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, probe_job.p.xyz, w.xyz, y, probe_light_normal(probe_job.light, y)); }
+            if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, light_measure(probe_job.light, probe_job.p.xyz), probe_job.p.xyz, w.xyz, y, probe_light_normal(probe_job.light, y)); }
         }
         case R_BSDF: { pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz); }
         case R_ENV: { pdf = env_pdf(w.xyz); }

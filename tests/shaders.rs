@@ -46,7 +46,7 @@ fn baked_scene_modules_validate_and_have_their_own_keys() {
 }
 
 /// The light contract (shaders/lights.wgsl's header; docs/adding-a-light.md): every light kind `LIGHT_K` of
-/// common.wgsl has exactly `k_sample_li`, `k_pdf_li` and `k_eval`, each dispatcher has exactly one `case` per kind
+/// common.wgsl has exactly `k_measure`, `k_sample_li`, `k_pdf_li` and `k_eval`, each dispatcher has one `case` per kind
 /// calling its function, and nothing else in the shaders names a kind or switches on one. On the Rust side a kind's
 /// tag is named only where the light table is built and where the scene's features are read.
 #[test]
@@ -73,7 +73,12 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         let rest = &lights[start + 3..];
         rest[..rest.find("\nfn ").unwrap_or(rest.len())].to_string()
     };
-    let ops = [("light_sample_li", "sample_li"), ("light_pdf_li", "pdf_li"), ("light_eval", "eval")];
+    let ops = [
+        ("light_measure", "measure"),
+        ("light_sample_li", "sample_li"),
+        ("light_pdf_li", "pdf_li"),
+        ("light_eval", "eval"),
+    ];
     for k in &kinds {
         let lower = k.to_lowercase();
         for (dispatcher, op) in ops {
@@ -84,8 +89,8 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
             assert_eq!(count(&b, &f), 1, "{dispatcher}'s case LIGHT_{k} must call {f}…)");
         }
     }
-    // Nothing else names a kind or switches on one: each kind's tag appears in the shaders only in its three cases
-    // (and its definition), and `.kind` is read only by the three dispatchers.
+    // Nothing else names a kind or switches on one: each kind's tag appears in the shaders only in its cases (and
+    // its definition), and `.kind` is read only by the dispatchers.
     let mut all = String::new();
     for (name, _) in mislab::shaders::FILES {
         if *name != "common.wgsl" {
@@ -93,9 +98,9 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         }
     }
     for k in &kinds {
-        assert_eq!(count(&all, &format!("LIGHT_{k}")), 3, "LIGHT_{k} is named outside the light dispatchers");
+        assert_eq!(count(&all, &format!("LIGHT_{k}")), ops.len(), "LIGHT_{k} is named outside the light dispatchers");
     }
-    assert_eq!(count(&all, ".kind"), 3, "something besides the three dispatchers reads a light's kind");
+    assert_eq!(count(&all, ".kind"), ops.len(), "something besides the dispatchers reads a light's kind");
     // Rust: the tag is defined in gpu_types.rs, turned into table entries in gpu_scene.rs and into HAS_* flags in
     // features.rs, and named in no other file of src/.
     let mut files = Vec::new();
