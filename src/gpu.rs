@@ -203,9 +203,25 @@ impl GpuContext {
 
     /// A storage buffer initialised with `data` (at least 16 bytes, so empty tables still bind).
     pub fn storage_buffer<T: bytemuck::Pod>(&self, label: &str, data: &[T], extra: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.storage_buffer_padded(label, bytemuck::cast_slice(data), std::mem::size_of::<T>(), extra)
+    }
+
+    /// A read-only storage buffer of raw bytes holding elements of `element_size` bytes (an empty one gets one
+    /// zero element, as `storage_buffer`).
+    pub fn storage_buffer_bytes(&self, label: &str, bytes: &[u8], element_size: usize) -> wgpu::Buffer {
+        self.storage_buffer_padded(label, bytes, element_size, wgpu::BufferUsages::empty())
+    }
+
+    fn storage_buffer_padded(
+        &self,
+        label: &str,
+        bytes: &[u8],
+        element_size: usize,
+        extra: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
         use wgpu::util::DeviceExt;
-        let mut bytes = bytemuck::cast_slice::<T, u8>(data).to_vec();
-        let min = 16.max(std::mem::size_of::<T>());
+        let mut bytes = bytes.to_vec();
+        let min = 16.max(element_size);
         if bytes.len() < min {
             bytes.resize(min, 0);
         }

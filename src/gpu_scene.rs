@@ -1,6 +1,7 @@
 //! GpuScene: the scene flattened into the storage buffers the shaders read (geometry + BVH, shading
 //! data, light table, textures, environment distribution), with size checks against device limits.
 
+use crate::bindings;
 use crate::bvh;
 use crate::gpu::GpuContext;
 use crate::gpu_types::*;
@@ -365,54 +366,21 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
 pub struct GpuScene {
     /// The CPU copy (statistics, light counts, environment parameters).
     pub data: SceneData,
-    /// Group-0 buffers in binding order 0..=12.
+    /// Group-0 buffers in binding order (`bindings::SCENE`).
     pub buffers: Vec<wgpu::Buffer>,
 }
 
-/// Names of the group-0 bindings, in order (for messages about device limits).
-pub const BINDING_NAMES: [&str; 13] = [
-    "BVH nodes",
-    "primitive references",
-    "triangle vertices",
-    "spheres",
-    "quads",
-    "triangle shading data",
-    "materials",
-    "lights",
-    "light alias table",
-    "texture table",
-    "texels",
-    "environment texels",
-    "environment alias table",
-];
-
-/// Bytes of each group-0 buffer of `data`, in binding order (see [`BINDING_NAMES`]).
+/// Bytes of each group-0 buffer of `data`, in binding order (`bindings::SCENE`).
 pub fn binding_sizes(data: &SceneData) -> [u64; 13] {
-    fn bytes<T>(v: &[T]) -> u64 {
-        std::mem::size_of_val(v) as u64
-    }
-    [
-        bytes(&data.bvh_nodes),
-        bytes(&data.prim_refs),
-        bytes(&data.tri_verts),
-        bytes(&data.spheres),
-        bytes(&data.quads),
-        bytes(&data.tri_shading),
-        bytes(&data.materials),
-        bytes(&data.lights),
-        bytes(&data.light_alias),
-        bytes(&data.tex_info),
-        bytes(&data.tex_texels),
-        bytes(&data.env_texels),
-        bytes(&data.env_alias),
-    ]
+    bindings::SCENE.map(|b| (b.bytes)(data).len() as u64)
 }
 
 /// Checks every group-0 buffer against a device's storage-buffer binding limit (bytes). The error names the
 /// buffer, its size and the limit, so that the user knows what to shrink.
 pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), String> {
     let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
-    for (name, size) in BINDING_NAMES.iter().zip(binding_sizes(data)) {
+    for (b, size) in bindings::SCENE.iter().zip(binding_sizes(data)) {
+        let name = b.binding.label;
         if size > limit {
             return Err(format!(
                 "the scene is too large for this device: its {name} need {:.1} MiB ({size} bytes), more than the device's max_storage_buffer_binding_size of {} MiB ({limit} bytes)",
@@ -429,22 +397,10 @@ impl GpuScene {
     /// larger than the device's storage-buffer binding limit.
     pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, String> {
         check_binding_sizes(&data, ctx.max_storage_binding())?;
-        let u = wgpu::BufferUsages::empty();
-        let buffers = vec![
-            ctx.storage_buffer("bvh_nodes", &data.bvh_nodes, u),
-            ctx.storage_buffer("prim_refs", &data.prim_refs, u),
-            ctx.storage_buffer("tri_verts", &data.tri_verts, u),
-            ctx.storage_buffer("spheres", &data.spheres, u),
-            ctx.storage_buffer("quads", &data.quads, u),
-            ctx.storage_buffer("tri_shading", &data.tri_shading, u),
-            ctx.storage_buffer("materials", &data.materials, u),
-            ctx.storage_buffer("lights", &data.lights, u),
-            ctx.storage_buffer("light_alias", &data.light_alias, u),
-            ctx.storage_buffer("tex_info", &data.tex_info, u),
-            ctx.storage_buffer("tex_texels", &data.tex_texels, u),
-            ctx.storage_buffer("env_texels", &data.env_texels, u),
-            ctx.storage_buffer("env_alias", &data.env_alias, u),
-        ];
+        let buffers = bindings::SCENE
+            .iter()
+            .map(|b| ctx.storage_buffer_bytes(b.binding.name, (b.bytes)(&data), b.binding.element_size))
+            .collect();
         Ok(GpuScene { data, buffers })
     }
 }

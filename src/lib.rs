@@ -5,6 +5,7 @@
 
 pub mod baked;
 pub mod bench;
+pub mod bindings;
 pub mod bvh;
 pub mod chi2;
 pub mod convex_solids;

@@ -16,6 +16,7 @@ use bytemuck::Pod;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
+use crate::bindings;
 use crate::bvh::Bvh;
 use crate::gpu::{GpuContext, GpuError};
 use crate::gpu_types::{GpuQuad, GpuSphere};
@@ -121,7 +122,8 @@ impl<'a> Probe<'a> {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
 
         let geometry_layout = job.geometry.map(|_| {
-            let entries: Vec<_> = (0..5).map(|b| storage_entry(b, true)).collect();
+            let geometry = &bindings::SCENE[..bindings::GEOMETRY_BINDINGS as usize];
+            let entries: Vec<_> = geometry.iter().map(|b| bindings::layout_entry(&b.binding)).collect();
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("probe geometry"),
                 entries: &entries,

@@ -1,6 +1,7 @@
 //! Renderer: the render pipeline, per-render buffers (frame parameters, accumulation, counters),
 //! progressive dispatch, reset and readback.
 
+use crate::bindings;
 use crate::features::{Features, PipelineKey};
 use crate::film::Film;
 use crate::gpu::{GpuContext, GpuError};
@@ -150,38 +151,15 @@ impl Renderer {
     ) -> Result<Renderer, String> {
         settings.validate()?;
         let device = ctx.device.clone();
-        let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let scene_entries: Vec<_> = (0..scene.buffers.len() as u32).map(|i| storage(i, true)).collect();
+        let scene_entries: Vec<_> = bindings::SCENE.iter().map(|b| bindings::layout_entry(&b.binding)).collect();
         let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
             entries: &scene_entries,
         });
+        let frame_entries: Vec<_> = bindings::FRAME.iter().map(bindings::layout_entry).collect();
         let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<GpuFrameParams>() as u64),
-                    },
-                    count: None,
-                },
-                storage(1, false),
-                storage(2, false),
-                storage(3, true),
-            ],
+            entries: &frame_entries,
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("render"),

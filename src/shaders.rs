@@ -4,11 +4,9 @@
 /// Every WGSL file, by name, embedded at compile time.
 pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../shaders/common.wgsl")),
-    ("geometry_bindings.wgsl", include_str!("../shaders/geometry_bindings.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
     ("baked_geometry.wgsl", include_str!("../shaders/baked_geometry.wgsl")),
     ("scene_data.wgsl", include_str!("../shaders/scene_data.wgsl")),
-    ("shading_bindings.wgsl", include_str!("../shaders/shading_bindings.wgsl")),
     ("specialize.wgsl", include_str!("../shaders/specialize.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("samplers.wgsl", include_str!("../shaders/samplers.wgsl")),
@@ -22,13 +20,20 @@ pub const FILES: &[(&str, &str)] = &[
     ("display.wgsl", include_str!("../shaders/display.wgsl")),
 ];
 
-/// The source of one embedded file.
-pub fn file(name: &str) -> &'static str {
-    FILES
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, s)| *s)
-        .unwrap_or_else(|| panic!("no embedded shader file named {name}"))
+/// Modules generated from Rust tables rather than embedded: the binding declarations (`crate::bindings`).
+pub const GENERATED: &[&str] = &["geometry_bindings.wgsl", "shading_bindings.wgsl"];
+
+/// The source of one embedded or generated file.
+pub fn file(name: &str) -> std::borrow::Cow<'static, str> {
+    match name {
+        "geometry_bindings.wgsl" => crate::bindings::geometry_wgsl().into(),
+        "shading_bindings.wgsl" => crate::bindings::shading_wgsl().into(),
+        _ => FILES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| (*s).into())
+            .unwrap_or_else(|| panic!("no embedded shader file named {name}")),
+    }
 }
 
 /// Concatenates files (in order) and extra source into one module, with a marker line per file so
@@ -37,7 +42,7 @@ pub fn compose(files: &[&str], extra: &str) -> String {
     let mut out = String::new();
     for f in files {
         out += &format!("// ---- {f} ----\n");
-        out += file(f);
+        out += &file(f);
         out += "\n";
     }
     out += extra;
@@ -49,7 +54,10 @@ pub fn compose_replacing(files: &[&str], replacements: &[(&str, &str)]) -> Strin
     let mut out = String::new();
     for f in files {
         out += &format!("// ---- {f} ----\n");
-        out += replacements.iter().find(|(n, _)| n == f).map_or_else(|| file(f), |(_, text)| text);
+        match replacements.iter().find(|(n, _)| n == f) {
+            Some((_, text)) => out += text,
+            None => out += &file(f),
+        }
         out += "\n";
     }
     out

@@ -179,3 +179,45 @@ fn tag_constants_match() {
         assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");
     }
 }
+
+/// Every binding the composed render module declares is in `bindings::{SCENE, FRAME}` with the same name,
+/// address space and access, and its element (array stride, or the uniform struct's size) has the size the Rust
+/// side uploads; every table entry is declared. The WGSL is generated from the table, so this checks the
+/// generator and the element sizes typed into the table against naga's own layout.
+#[test]
+fn bindings_match_the_table() {
+    use mislab::bindings::{self, Access};
+    let m = module();
+    let mut seen = Vec::new();
+    for (_, var) in m.global_variables.iter() {
+        let Some(rb) = &var.binding else { continue };
+        let b = bindings::all()
+            .find(|b| b.group == rb.group && b.binding == rb.binding)
+            .unwrap_or_else(|| panic!("WGSL binding ({}, {}) is not in the table", rb.group, rb.binding));
+        let name = var.name.clone().unwrap_or_default();
+        assert_eq!(name, b.name, "binding ({}, {})", b.group, b.binding);
+        let access = match var.space {
+            naga::AddressSpace::Uniform => Access::Uniform,
+            naga::AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => Access::ReadWrite,
+            naga::AddressSpace::Storage { .. } => Access::Read,
+            other => panic!("{name}: unexpected address space {other:?}"),
+        };
+        assert_eq!(access, b.access, "{name}: access");
+        let element = match &m.types[var.ty].inner {
+            naga::TypeInner::Array { stride, .. } => *stride,
+            inner => inner.size(m.to_ctx()),
+        };
+        assert_eq!(element as usize, b.element_size, "{name}: WGSL element size {element} vs the table's");
+        seen.push((b.group, b.binding));
+    }
+    for b in bindings::all() {
+        assert!(
+            seen.contains(&(b.group, b.binding)),
+            "{} ({}, {}) is not declared in WGSL",
+            b.name,
+            b.group,
+            b.binding
+        );
+    }
+    assert_eq!(bindings::SCENE.len(), mislab::gpu_scene::binding_sizes(&Default::default()).len());
+}

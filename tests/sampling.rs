@@ -279,14 +279,15 @@ impl Harness {
             .expect("the sampling tests need a Vulkan adapter (install mesa-vulkan-drivers for lavapipe)");
         let device = &ctx.device;
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
-        let scene_entries: Vec<_> = (0..13).map(|b| layout_entry(b, ro)).collect();
+        let scene_entries: Vec<_> =
+            mislab::bindings::SCENE.iter().map(|b| mislab::bindings::layout_entry(&b.binding)).collect();
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe scene"),
             entries: &scene_entries,
         });
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe frame"),
-            entries: &[layout_entry(0, wgpu::BufferBindingType::Uniform)],
+            entries: &[mislab::bindings::layout_entry(&mislab::bindings::FRAME[0])],
         });
         let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe io"),
