@@ -39,11 +39,6 @@ impl GpuTimer {
         self.used == self.capacity
     }
 
-    /// Passes timed since the last read.
-    pub fn passes(&self) -> u32 {
-        self.used
-    }
-
     /// The timestamp writes of the next pass; None when full (that pass then goes untimed).
     pub fn pass(&mut self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         if self.is_full() {

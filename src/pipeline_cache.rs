@@ -48,14 +48,4 @@ impl PipelineCache {
     pub fn clear(&mut self) {
         self.map.clear();
     }
-
-    /// How many pipelines are built.
-    pub fn len(&self) -> usize {
-        self.map.len()
-    }
-
-    /// Whether none is.
-    pub fn is_empty(&self) -> bool {
-        self.map.is_empty()
-    }
 }
