@@ -43,6 +43,7 @@ const ENV_SAMPLING_IMPORTANCE: u32 = 1u;
 
 const LIGHT_SELECT_UNIFORM: u32 = 0u;
 const LIGHT_SELECT_POWER: u32 = 1u;
+const LIGHT_SELECT_TREE: u32 = 2u;
 
 const HEURISTIC_BALANCE: u32 = 0u;
 const HEURISTIC_POWER: u32 = 1u;
@@ -130,6 +131,25 @@ struct Light {
     cos_outer: f32,
     area: f32,
     pmf_uniform: f32,
+    tree_trail: u32,       // the light's root-to-leaf path in light_tree (bit k: second child at depth k)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+/// A light-tree node (src/light_tree.rs): bounds, power φ, orientation cone (axis, cos θo) and emission spread cos θe
+/// of the lights below. Interior: first child next, second at `second`; leaf (second = INVALID): light `light`.
+struct LightNode {
+    lo: vec3<f32>,
+    phi: f32,
+    hi: vec3<f32>,
+    second: u32,
+    axis: vec3<f32>,
+    cos_o: f32,
+    cos_e: f32,
+    light: u32,
+    two_sided: u32,
+    count: u32,
 }
 
 /// Alias-table entry: take `index` with probability `prob`, else `alias`.

@@ -110,8 +110,8 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     var out = LightEstimate(vec3<f32>(0.0), LightMeasure(MEASURE_NONE, 0.0));
     if (params.num_lights == 0u) { return out; }
     let base = dim_base(c.bounce, j);
-    let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT));
-    let pmf = light_pmf(li);
+    let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT), c.x.p, c.x.ns);
+    let pmf = light_pmf(li, c.x.p, c.x.ns);
     let u = vec3<f32>(sample_2d(c.id, base + DIM_LIGHT_UV), sample_1d(c.id, base + DIM_LIGHT_EXTRA));
     let ls = light_sample_li(li, c.x.p, u);
     out.m = ls.m;
@@ -163,9 +163,9 @@ fn light_measure_known() -> bool {
 }
 
 /// Block 2, the direction technique: the MIS weight of emission `found` along w, a direction it sampled from the
-/// shading point `from_p` with pdf p_dir, against the light technique's pdf of w (selection included). `known`:
-/// the measure of the first light sample taken at from_p.
-fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, w: vec3<f32>, known: LightMeasure) -> f32 {
+/// shading point `from_p` (shading normal from_n) with pdf p_dir, against the light technique's pdf of w
+/// (selection included). `known`: the measure of the first light sample taken at from_p.
+fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, from_n: vec3<f32>, w: vec3<f32>, known: LightMeasure) -> f32 {
     if (!mis_on()) { return 1.0; }
     var p_light = 0.0;
     if (found.light == params.env_light) {
@@ -176,7 +176,7 @@ fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, w: vec3<f32
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
         p_light = light_pdf_li(found.light, m, from_p, w, found.surface.p, found.surface.ng);
     }
-    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(found.light) * p_light);
+    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(found.light, from_p, from_n) * p_light);
 }
 
 // ---- shade() ----
@@ -251,7 +251,7 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
             let found = found_emission(o, w, trace_closest(o, w, F32_MAX));
             if (all(found.le == vec3<f32>(0.0))) { continue; }
             let f = bsdf_eval(c.brdf, c.wo, ds.xyz);
-            out.radiance += direction_mis_weight(ds.w, found, c.x.p, w, out.light) * found.le * f * ds.z / ds.w * plan.dir_scale;
+            out.radiance += direction_mis_weight(ds.w, found, c.x.p, c.x.ns, w, out.light) * found.le * f * ds.z / ds.w * plan.dir_scale;
         }
     }
     out.next_valid = false;

@@ -25,6 +25,7 @@ struct PathRay {
     o: vec3<f32>,
     d: vec3<f32>,
     from_p: vec3<f32>,       // the shading point it leaves (for the light technique's pdf of what it finds)
+    from_n: vec3<f32>,       // its shading normal (the light tree's selection depends on it)
     dir_pdf: f32,            // pdf of the direction technique that chose d
     emission_scale: f32,     // factor on the emission it finds (0: not a counted direction sample)
     light: LightMeasure,     // how the first light sample at from_p was drawn
@@ -39,6 +40,7 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
     r.o = params.cam_origin;
     r.d = camera_direction(px, sample_2d(id, 0u));
     r.from_p = params.cam_origin;
+    r.from_n = vec3<f32>(0.0);
     r.dir_pdf = 0.0;
     r.emission_scale = 1.0;
     r.light = LightMeasure(MEASURE_NONE, 0.0);
@@ -58,7 +60,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     // The camera ray is no direction technique's sample: its emission counts in full.
     var w = ray.emission_scale;
     if (ray.bounce > 0u && w > 0.0 && any(found.le != vec3<f32>(0.0))) {
-        w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.d, ray.light);
+        w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.d, ray.light);
     }
     (*r).l += ray.beta * (w * found.le);
     if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
@@ -81,6 +83,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     (*r).o = s.next_origin;
     (*r).d = s.next_dir;
     (*r).from_p = x.p;
+    (*r).from_n = x.ns;
     (*r).dir_pdf = s.next_pdf;
     (*r).emission_scale = s.next_scale;
     (*r).light = s.light;

@@ -103,8 +103,22 @@ const MATERIAL_MEMBERS: &[&str] = &[
     "vec4<f32>",
     "vec4<f32>",
 ];
-const LIGHT_MEMBERS: &[&str] =
-    &["vec3<f32>", "u32", "vec3<f32>", "u32", "vec3<f32>", "f32", "f32", "f32", "f32", "f32"];
+const LIGHT_MEMBERS: &[&str] = &[
+    "vec3<f32>",
+    "u32",
+    "vec3<f32>",
+    "u32",
+    "vec3<f32>",
+    "f32",
+    "f32",
+    "f32",
+    "f32",
+    "f32",
+    "u32",
+    "u32",
+    "u32",
+    "u32",
+];
 
 /// A WGSL constructor `name(...)` for one struct given as 4-byte words, or None if a float is not finite (WGSL
 /// has no literal for it; that table is then read from its buffer).

@@ -6,6 +6,7 @@
 use crate::bvh::GpuBvhNode;
 use crate::gpu_scene::SceneData;
 use crate::gpu_types::*;
+use crate::light_tree::GpuLightNode;
 
 /// How a shader reaches a binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,7 +63,7 @@ const fn scene(
 pub const GEOMETRY_BINDINGS: u32 = 5;
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 13] = [
+pub const SCENE: [SceneBinding; 14] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -117,6 +118,10 @@ pub const SCENE: [SceneBinding; 13] = [
     SceneBinding {
         binding: scene(12, "env_alias", "array<AliasEntry>", size_of::<GpuAliasEntry>(), "environment alias table"),
         bytes: |d| bytemuck::cast_slice(&d.env_alias),
+    },
+    SceneBinding {
+        binding: scene(13, "light_tree", "array<LightNode>", size_of::<GpuLightNode>(), "light tree"),
+        bytes: |d| bytemuck::cast_slice(&d.light_tree),
     },
 ];
 

@@ -5,6 +5,7 @@ use crate::bindings;
 use crate::bvh;
 use crate::gpu::GpuContext;
 use crate::gpu_types::*;
+use crate::light_tree::{GpuLightNode, LightBounds, LightTree};
 use crate::lights::{self, luminance};
 use crate::scene::{Environment, PunctualLight, Scene, TextureRef, Wrap};
 use glam::Vec3;
@@ -27,6 +28,8 @@ pub struct SceneData {
     pub lights: Vec<GpuLight>,
     /// Alias table for power-proportional light selection.
     pub light_alias: Vec<GpuAliasEntry>,
+    /// The light tree over the lights with a position (`--light-select tree`), depth-first; empty if none.
+    pub light_tree: Vec<GpuLightNode>,
     /// Texture table.
     pub tex_info: Vec<GpuTextureInfo>,
     /// All texels, RGBA8 packed.
@@ -289,7 +292,11 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
         lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, ..Default::default() });
     }
     let r = scene_radius(d);
-    for l in &scene.punctual_lights {
+    // Lights with a position first, then the infinite ones (directional, environment): the light tree covers
+    // the first `bounded` entries and the shader finds the infinite ones after them.
+    let punctual = scene.punctual_lights.iter().filter(|l| !matches!(l, PunctualLight::Directional { .. }));
+    let directional = scene.punctual_lights.iter().filter(|l| matches!(l, PunctualLight::Directional { .. }));
+    for l in punctual.chain(directional) {
         let (g, p) = match *l {
             PunctualLight::Point { position, intensity } => (
                 GpuLight {
@@ -358,8 +365,66 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
         l.pmf_power = *p as f32;
         l.pmf_uniform = 1.0 / n as f32;
     }
+    let bounded = lights.iter().take_while(|l| !matches!(l.kind, LIGHT_DIRECTIONAL | LIGHT_ENVIRONMENT)).count();
+    debug_assert!(lights[bounded..].iter().all(|l| matches!(l.kind, LIGHT_DIRECTIONAL | LIGHT_ENVIRONMENT)));
+    let bounds: Vec<LightBounds> =
+        lights[..bounded].iter().zip(&power).map(|(l, &p)| light_bounds(l, p, tris, d)).collect();
+    let tree = LightTree::build(&bounds, &(0..bounded as u32).collect::<Vec<_>>());
+    for (l, &trail) in lights.iter_mut().zip(&tree.trails) {
+        l.tree_trail = trail;
+    }
+    d.light_tree = tree.nodes;
     d.lights = lights;
     d.light_alias = table.entries;
+}
+
+/// Where light `l` (of power `power`) is and emits, for the light tree: area emitters are one-sided (their front
+/// is the side `*_sample_li` accepts), spheres and point lights emit everywhere, spots into their outer cone.
+fn light_bounds(l: &GpuLight, power: f64, tris: &[[Vec3; 3]], d: &SceneData) -> LightBounds {
+    let everywhere = |lo: Vec3, hi: Vec3| LightBounds {
+        lo,
+        hi,
+        phi: power as f32,
+        axis: Vec3::Z,
+        cos_o: -1.0,
+        cos_e: 0.0,
+        two_sided: false,
+    };
+    let facing = |pts: &[Vec3], normal: Vec3| {
+        let lo = pts.iter().fold(Vec3::splat(f32::MAX), |a, &p| a.min(p));
+        let hi = pts.iter().fold(Vec3::splat(f32::MIN), |a, &p| a.max(p));
+        LightBounds { axis: normal.normalize_or(Vec3::Z), cos_o: 1.0, ..everywhere(lo, hi) }
+    };
+    match l.kind {
+        LIGHT_TRIANGLE => {
+            let t = tris[l.prim as usize];
+            facing(&t, (t[1] - t[0]).cross(t[2] - t[0]))
+        }
+        LIGHT_QUAD => {
+            let q = d.quads[l.prim as usize];
+            let (c, u, v) = (Vec3::from(q.corner), Vec3::from(q.edge_u), Vec3::from(q.edge_v));
+            facing(&[c, c + u, c + v, c + u + v], u.cross(v))
+        }
+        LIGHT_SPHERE => {
+            let s = d.spheres[l.prim as usize];
+            let c = Vec3::from(s.center);
+            everywhere(c - s.radius, c + s.radius)
+        }
+        LIGHT_SPOT => {
+            let p = Vec3::from(l.position);
+            let (theta_i, theta_o) = (l.cos_inner.clamp(-1.0, 1.0).acos(), l.cos_outer.clamp(-1.0, 1.0).acos());
+            LightBounds {
+                axis: Vec3::from(l.direction),
+                cos_o: l.cos_inner,
+                cos_e: (theta_o - theta_i).max(0.0).cos(),
+                ..everywhere(p, p)
+            }
+        }
+        _ => {
+            let p = Vec3::from(l.position);
+            everywhere(p, p)
+        }
+    }
 }
 
 /// The scene's buffers on a device, bound as group 0 of the render pipeline.
@@ -371,7 +436,7 @@ pub struct GpuScene {
 }
 
 /// Bytes of each group-0 buffer of `data`, in binding order (`bindings::SCENE`).
-pub fn binding_sizes(data: &SceneData) -> [u64; 13] {
+pub fn binding_sizes(data: &SceneData) -> [u64; bindings::SCENE.len()] {
     bindings::SCENE.map(|b| (b.bytes)(data).len() as u64)
 }
 

@@ -107,6 +107,11 @@ pub struct GpuLight {
     pub cos_outer: f32,
     pub area: f32,
     pub pmf_uniform: f32,
+    /// Its path in the light tree (`light_tree::LightTree::trails`; 0 for lights outside it).
+    pub tree_trail: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// Alias-table entry (WGSL `AliasEntry`).

@@ -16,6 +16,7 @@ pub mod gpu;
 pub mod gpu_scene;
 pub mod gpu_timer;
 pub mod gpu_types;
+pub mod light_tree;
 pub mod lights;
 pub mod metrics;
 pub mod pipeline_cache;

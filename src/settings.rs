@@ -90,6 +90,8 @@ settings_enum!(
         Uniform = 0 => "uniform",
         /// Proportional to emitted power (alias table).
         Power = 1 => "power",
+        /// By the light tree: power, distance, orientation and the surface's normal (src/light_tree.rs).
+        Tree = 2 => "tree",
     }
 );
 

@@ -67,7 +67,28 @@ fn shared_structs_match() {
         m,
         "Light",
         GpuLight,
-        [position, kind, direction, prim, radiance, pmf_power, cos_inner, cos_outer, area, pmf_uniform]
+        [
+            position,
+            kind,
+            direction,
+            prim,
+            radiance,
+            pmf_power,
+            cos_inner,
+            cos_outer,
+            area,
+            pmf_uniform,
+            tree_trail,
+            _pad0,
+            _pad1,
+            _pad2
+        ]
+    );
+    check!(
+        m,
+        "LightNode",
+        mislab::light_tree::GpuLightNode,
+        [lo, phi, hi, second, axis, cos_o, cos_e, light, two_sided, count]
     );
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
     check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, _pad0]);

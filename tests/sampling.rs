@@ -23,7 +23,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 54;
+const FAMILY: usize = 59;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -153,8 +153,8 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             if (s.pdf > 0.0) { o1 = vec4<f32>(env_pdf(s.wi), 0.0, luminance(s.radiance), 0.0); }
         }
         case R_SELECT: {
-            let k = select_light(u.x);
-            o0 = vec4<f32>(f32(k), light_pmf(k), 0.0, 0.0);
+            let k = select_light(u.x, p, probe_job.a.xyz);
+            o0 = vec4<f32>(f32(k), light_pmf(k, p, probe_job.a.xyz), 0.0, 0.0);
         }
         case R_SPHERICAL_TRIANGLE: {
             let w = square_to_spherical_triangle(u.xy, p, probe_job.a.xyz, probe_job.b.xyz);
@@ -190,7 +190,7 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         }
         case R_BSDF: { pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz); }
         case R_ENV: { pdf = env_pdf(w.xyz); }
-        case R_SELECT: { pdf = light_pmf(u32(w.x)); }
+        case R_SELECT: { pdf = light_pmf(u32(w.x), probe_job.p.xyz, probe_job.a.xyz); }
         default: {}
     }
     probe_out[i] = vec4<f32>(pdf, 0.0, 0.0, 0.0);
@@ -239,6 +239,7 @@ enum SceneId {
     EnvPixel = 1,
     Env3x2 = 2,
     EnvHdr = 3,
+    ManyLights = 4,
 }
 
 struct Bound {
@@ -319,24 +320,25 @@ impl Harness {
             layout: &frame_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() }],
         });
-        let scenes = [lights_scene(), env_scene(pixel_map()), env_scene(map_3x2()), env_scene(hdr_map())]
-            .into_iter()
-            .map(|s| {
-                let scene = GpuScene::upload(&ctx, SceneData::build(&s)).expect("upload");
-                let entries: Vec<_> = scene
-                    .buffers
-                    .iter()
-                    .enumerate()
-                    .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-                    .collect();
-                let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("probe scene"),
-                    layout: &scene_layout,
-                    entries: &entries,
-                });
-                Bound { scene, group }
-            })
-            .collect();
+        let scenes =
+            [lights_scene(), env_scene(pixel_map()), env_scene(map_3x2()), env_scene(hdr_map()), many_lights_scene()]
+                .into_iter()
+                .map(|s| {
+                    let scene = GpuScene::upload(&ctx, SceneData::build(&s)).expect("upload");
+                    let entries: Vec<_> = scene
+                        .buffers
+                        .iter()
+                        .enumerate()
+                        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                        .collect();
+                    let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("probe scene"),
+                        layout: &scene_layout,
+                        entries: &entries,
+                    });
+                    Bound { scene, group }
+                })
+                .collect();
         Harness { ctx, sample, pdf, io_layout, params, frame_group, scenes, lock: Mutex::new(()) }
     }
 
@@ -525,6 +527,53 @@ fn lights_scene() -> Scene {
             Sphere { center: Vec3::new(0.0, -4.0, 0.0), radius: 0.25, material: 1 },
         ],
         punctual_lights: vec![PunctualLight::Point { position: Vec3::new(0.0, 5.0, 0.0), intensity: Vec3::splat(3.0) }],
+        ..Default::default()
+    }
+}
+
+/// 1200 small emissive triangles of varied power and orientation over a 20 × 20 floor, a sphere, a spot, a
+/// directional light and a constant sky: the light tree's test scene (infinite lights outside the tree).
+fn many_lights_scene() -> Scene {
+    let mut materials = Vec::new();
+    let mut meshes = Vec::new();
+    for i in 0..1200 {
+        let f = i as f32;
+        let c = Vec3::new(
+            (f * 0.618_034).fract() * 20.0 - 10.0,
+            0.2 + (f * 0.414_214).fract() * 3.0,
+            (f * 0.732_051).fract() * 20.0 - 10.0,
+        );
+        let n = Vec3::new((f * 1.3).sin(), (f * 0.7).cos(), (f * 2.1).cos()).normalize();
+        let t = n.any_orthonormal_vector();
+        let b = n.cross(t);
+        let size = 0.05 + 0.1 * (f * 0.27).fract();
+        if i % 40 == 0 {
+            materials.push(Material::emitter(&format!("e{i}"), Vec3::splat(0.1 + 20.0 * (f * 0.37).fract())));
+        }
+        meshes.push(Mesh {
+            name: format!("t{i}"),
+            positions: vec![c, c + size * t, c + size * b],
+            indices: vec![[0, 1, 2]],
+            material: (i / 40) as u32,
+            ..Default::default()
+        });
+    }
+    Scene {
+        name: "sampling-many-lights".into(),
+        spheres: vec![Sphere { center: Vec3::new(3.0, 2.0, -2.0), radius: 0.3, material: 0 }],
+        materials,
+        meshes,
+        punctual_lights: vec![
+            PunctualLight::Spot {
+                position: Vec3::new(-4.0, 4.0, 1.0),
+                direction: Vec3::new(0.3, -1.0, 0.1),
+                intensity: Vec3::splat(40.0),
+                inner_cone: 0.3,
+                outer_cone: 0.5,
+            },
+            PunctualLight::Directional { direction: Vec3::new(0.2, -1.0, 0.3), irradiance: Vec3::splat(0.5) },
+        ],
+        environment: Environment::Constant(Vec3::splat(0.05)),
         ..Default::default()
     }
 }
@@ -1285,10 +1334,84 @@ fn chi2_light_selection() {
     }
 }
 
+/// Shading points (p, n) where the light tree is tested: above the floor looking up, among the emitters, below
+/// them facing away, far outside, and with no normal (n = 0, as a camera-side query would be).
+const TREE_POINTS: [(&str, [f32; 3], [f32; 3]); 5] = [
+    ("floor, n up", [0.5, 0.0, -1.0], [0.0, 1.0, 0.0]),
+    ("among emitters", [2.0, 1.5, 3.0], [0.6, 0.0, 0.8]),
+    ("below, n down", [-3.0, -1.0, 2.0], [0.0, -1.0, 0.0]),
+    ("far away", [60.0, 30.0, -40.0], [-0.8, -0.6, 0.0]),
+    ("no normal", [0.0, 2.0, 0.0], [0.0, 0.0, 0.0]),
+];
+
+/// The light tree (`--light-select tree`) on the device: for shading points across the many-light scene, the
+/// sampled light indices pass a chi-square test against the tree's own pmf function, the pmf a sample returns is
+/// that function's value bit for bit (so a light found by a BSDF sample gets the pmf of sampling it), Σ pmf = 1
+/// over all lights, and the device's pmf of every light in the tree matches the CPU walk (light_tree::pmf).
+#[test]
+fn chi2_light_tree_selection() {
+    let h = harness();
+    let d = h.data(SceneId::ManyLights);
+    let n_lights = d.lights.len();
+    let bounded = d.light_tree[0].count as usize;
+    assert_eq!(bounded, n_lights - 2, "the tree covers every light but the directional and the sky");
+    let mut rows = Vec::new();
+    let mut failures = Vec::new();
+    for (k, (name, p, n)) in TREE_POINTS.iter().enumerate() {
+        let mut s = Setup::new(SceneId::ManyLights, R_SELECT);
+        s.frame.light_select = LightSelect::Tree.tag();
+        s.job.p = [p[0], p[1], p[2], 0.0];
+        s.job.a = [n[0], n[1], n[2], 0.0];
+        let t0 = std::time::Instant::now();
+        let out = h.sample(&s, N, 0, 1, 311 + k as u32);
+        let mut counts = vec![0u64; n_lights];
+        for [a, _] in &out {
+            counts[a[0] as usize] += 1;
+        }
+        let pts: Vec<[[f32; 4]; 2]> = (0..n_lights).map(|i| [[i as f32, 0.0, 0.0, 0.0], [0.0; 4]]).collect();
+        let pmf = h.pdf(&s, &pts);
+        let mismatch = out
+            .iter()
+            .map(|[a, _]| ((a[1] as f64 - pmf[a[0] as usize]) / pmf[a[0] as usize]).abs())
+            .fold(0.0, f64::max);
+        let sum: f64 = pmf.iter().sum();
+        if (sum - 1.0).abs() > 1e-5 {
+            failures.push(format!("{name}: Σ pmf = {sum}"));
+        }
+        let (pv, nv) = (Vec3::from(*p), Vec3::from(*n));
+        let worst_cpu = (0..bounded)
+            .map(|i| {
+                let cpu = mislab::light_tree::pmf(&d.light_tree, d.lights[i].tree_trail, pv, nv) as f64 / 3.0;
+                (pmf[i] - cpu).abs() / cpu.max(1e-12)
+            })
+            .fold(0.0, f64::max);
+        if worst_cpu > 5e-4 {
+            failures.push(format!("{name}: device and CPU pmfs differ by {worst_cpu:.2e} (relative)"));
+        }
+        let report = chi2::discrete_test(&format!("light tree ({name})"), &counts, &pmf, alpha());
+        eprintln!("{}  [Σ pmf {sum:.7}, CPU match {worst_cpu:.1e}]", report.summary());
+        rows.push(Row {
+            report,
+            config: format!("{n_lights} lights, p {p:?}, n {n:?}"),
+            pdf_mismatch: mismatch,
+            pdf_outliers: 0.0,
+            pdf_match: (0.0, 0.0),
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+    }
+    record("tree selection", &rows);
+    for r in &rows {
+        if !(r.report.passed() && r.pdf_mismatch == 0.0) {
+            failures.push(format!("{} (pmf mismatch {:.2e})", r.report.summary(), r.pdf_mismatch));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 /// The number of chi-square tests equals the family size used for the Šidák correction.
 #[test]
 fn family_size() {
-    let n = warp_cases().len() + light_cases().len() + bsdf_cases().len() + env_cases().len() + 2;
+    let n = warp_cases().len() + light_cases().len() + bsdf_cases().len() + env_cases().len() + 2 + TREE_POINTS.len();
     assert_eq!(n, FAMILY, "update FAMILY to the number of chi-square tests");
 }
 
