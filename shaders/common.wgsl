@@ -44,6 +44,7 @@ const ENV_SAMPLING_IMPORTANCE: u32 = 1u;
 const LIGHT_SELECT_UNIFORM: u32 = 0u;
 const LIGHT_SELECT_POWER: u32 = 1u;
 const LIGHT_SELECT_TREE: u32 = 2u;
+const LIGHT_SELECT_RIS: u32 = 3u;
 
 const HEURISTIC_BALANCE: u32 = 0u;
 const HEURISTIC_POWER: u32 = 1u;
@@ -219,7 +220,8 @@ struct FrameParams {
     row_count: u32,
     /// Length scale of the scene around the render origin (≤ 1); see offset_ray_origin_scaled.
     offset_scale: f32,
-    _pad0: u32,
+    /// Candidates per light sample under `--light-select ris`.
+    ris_candidates: u32,
     _pad1: u32,
     _pad2: u32,
 }

@@ -109,6 +109,7 @@ struct LightEstimate {
 fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     var out = LightEstimate(vec3<f32>(0.0), LightMeasure(MEASURE_NONE, 0.0));
     if (params.num_lights == 0u) { return out; }
+    if (cfg_light_select() == LIGHT_SELECT_RIS) { return ris_light_technique(c, j); }
     let base = dim_base(c.bounce, j);
     let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT), c.x.p, c.x.ns);
     let pmf = light_pmf(li, c.x.p, c.x.ns);
@@ -128,6 +129,65 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
         w = mis_weight(f32(params.light_samples), p_light, f32(params.bsdf_samples), direction_pdf(c, wi));
     }
     out.radiance = w * ls.radiance * f * cos_s / p_light;
+    return out;
+}
+
+/// One light-sample candidate of RIS: the sample, f at its direction, and its target value p̂ = lum(f·L·cos).
+struct RisCandidate {
+    ls: LightSample,
+    f_cos: vec3<f32>,
+    p_hat: f32,
+}
+
+/// A candidate drawn with u = (selection, uv, extra): a light by power, a point on it; p̂ = 0 where it cannot
+/// contribute (below either hemisphere, no sample).
+fn ris_candidate(c: ShadingCtx, u: vec4<f32>) -> RisCandidate {
+    var r = RisCandidate(no_light_sample(), vec3<f32>(0.0), 0.0);
+    let li = select_light(u.x, c.x.p, c.x.ns);
+    r.ls = light_sample_li(li, c.x.p, u.yzw);
+    r.ls.pdf *= light_pmf(li, c.x.p, c.x.ns);
+    let cos_s = dot(r.ls.wi, c.x.ns);
+    if (!(r.ls.pdf > 0.0) || cos_s <= 0.0 || dot(r.ls.wi, c.x.ng) <= 0.0) { return r; }
+    r.f_cos = bsdf_eval(c.brdf, c.wo, to_local(c.frame, r.ls.wi)) * cos_s;
+    r.p_hat = luminance(r.f_cos * r.ls.radiance);
+    return r;
+}
+
+/// Block 1 by resampled importance sampling (Talbot et al. 2005): M = --ris-candidates candidates from the source
+/// density p_src = pmf_power · pdf_li, one kept with probability ∝ w = p̂/p_src (a one-slot reservoir), then one
+/// shadow ray. The kept y counts f·L·cos · W with W = (Σw / M) / p̂(y), whose expectation given y is 1/p(y) of the
+/// resampled density, so the estimate is unbiased wherever p̂ > 0 where f·L·cos ≠ 0 (luminance of positive rgb).
+/// MIS: RIS's own density has no closed form, so both techniques weigh with p_src standing in for it. Any weights
+/// that sum to one at each direction keep the sum of the two techniques unbiased (Veach 1997, §9.2): the choice
+/// moves variance only. Candidate 0 takes the sampler's dimensions; the others and the reservoir's coin are hashed.
+fn ris_light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
+    var out = LightEstimate(vec3<f32>(0.0), LightMeasure(MEASURE_NONE, 0.0));
+    let base = dim_base(c.bounce, j);
+    let m = max(params.ris_candidates, 1u);
+    var kept = RisCandidate(no_light_sample(), vec3<f32>(0.0), 0.0);
+    var w_sum = 0.0;
+    for (var k = 0u; k < m; k += 1u) {
+        var u = vec4<f32>(sample_1d(c.id, base + DIM_LIGHT_SELECT), sample_2d(c.id, base + DIM_LIGHT_UV),
+                          sample_1d(c.id, base + DIM_LIGHT_EXTRA));
+        let stream = hash4(c.id.pixel, c.id.index, base ^ (params.seed * 0x9e3779b9u), k);
+        if (k > 0u) {
+            u = vec4<f32>(bits_to_unit(pcg_hash(stream)), bits_to_unit(pcg_hash(stream + 1u)),
+                          bits_to_unit(pcg_hash(stream + 2u)), bits_to_unit(pcg_hash(stream + 3u)));
+        }
+        let cand = ris_candidate(c, u);
+        if (k == 0u) { out.m = cand.ls.m; }
+        if (!(cand.p_hat > 0.0)) { continue; }
+        let w = cand.p_hat / cand.ls.pdf;
+        w_sum += w;
+        if (bits_to_unit(pcg_hash(stream + 4u)) * w_sum < w) { kept = cand; }
+    }
+    if (!(kept.p_hat > 0.0) || !(w_sum > 0.0) || !unoccluded(c.x, kept.ls)) { return out; }
+    var weight = 1.0;
+    if (mis_on() && kept.ls.m.measure != MEASURE_DISCRETE) {
+        let wi = to_local(c.frame, kept.ls.wi);
+        weight = mis_weight(f32(params.light_samples), kept.ls.pdf, f32(params.bsdf_samples), direction_pdf(c, wi));
+    }
+    out.radiance = weight * kept.ls.radiance * kept.f_cos * (w_sum / f32(m) / kept.p_hat);
     return out;
 }
 

@@ -62,7 +62,9 @@ fn no_light_sample_in(m: LightMeasure) -> LightSample {
 fn light_pmf(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     if (MANY_LIGHTS && cfg_light_select() == LIGHT_SELECT_TREE) { return tree_light_pmf(i, p, n); }
     let l = scene_light(i);
-    return select(l.pmf_uniform, l.pmf_power, cfg_light_select() == LIGHT_SELECT_POWER);
+    // RIS draws its candidates by power: the MIS weights of both techniques use that source density (estimators.wgsl).
+    let by_power = cfg_light_select() == LIGHT_SELECT_POWER || cfg_light_select() == LIGHT_SELECT_RIS;
+    return select(l.pmf_uniform, l.pmf_power, by_power);
 }
 
 /// Samples an index from an alias table of `n` entries starting at `base` with one number u: the column from
@@ -97,7 +99,8 @@ fn select_light(u: f32, p: vec3<f32>, n: vec3<f32>) -> u32 {
     if (!MANY_LIGHTS) { return 0u; }
     let count = params.num_lights;
     if (cfg_light_select() == LIGHT_SELECT_TREE) { return tree_select_light(u, p, n); }
-    if (cfg_light_select() == LIGHT_SELECT_POWER) { return alias_sample(0u, count, u, false); }
+    let by_power = cfg_light_select() == LIGHT_SELECT_POWER || cfg_light_select() == LIGHT_SELECT_RIS;
+    if (by_power) { return alias_sample(0u, count, u, false); }
     return min(u32(u * f32(count)), count - 1u);
 }
 

@@ -189,7 +189,8 @@ pub struct GpuFrameParams {
     /// Length scale of the scene around the render origin (≤ 1): ray-origin offsets near the origin are
     /// proportional to it, so tiny scenes do not jump out of themselves.
     pub offset_scale: f32,
-    pub _pad0: u32,
+    /// Candidates per light sample under resampled importance sampling.
+    pub ris_candidates: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }

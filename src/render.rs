@@ -482,7 +482,7 @@ impl Renderer {
             row_offset: 0,
             row_count: s.height,
             offset_scale: self.offset_scale,
-            _pad0: 0,
+            ris_candidates: s.ris_candidates,
             _pad1: 0,
             _pad2: 0,
         }

@@ -92,6 +92,9 @@ settings_enum!(
         Power = 1 => "power",
         /// By the light tree: power, distance, orientation and the surface's normal (src/light_tree.rs).
         Tree = 2 => "tree",
+        /// Resampled importance sampling: `--ris-candidates` light samples by power, one kept ∝ its unshadowed
+        /// contribution (docs/estimators.md).
+        Ris = 3 => "ris",
     }
 );
 
@@ -170,6 +173,9 @@ pub struct Settings {
     /// Multi-sample or one-sample MIS.
     #[arg(long, value_enum, default_value_t = Settings::default().mis)]
     pub mis: MisKind,
+    /// Candidates per light sample under `--light-select ris` (1..=64).
+    #[arg(long, default_value_t = Settings::default().ris_candidates)]
+    pub ris_candidates: u32,
     /// Light samples per shading point (MIS multi, light strategy).
     #[arg(long, default_value_t = Settings::default().light_samples)]
     pub light_samples: u32,
@@ -207,6 +213,7 @@ impl Default for Settings {
             heuristic: Heuristic::Power,
             power_beta: 2.0,
             mis: MisKind::Multi,
+            ris_candidates: 8,
             light_samples: 1,
             bsdf_samples: 1,
             sampler: SamplerKind::Independent,
@@ -229,6 +236,9 @@ impl Settings {
         }
         if self.light_samples > 64 || self.bsdf_samples > 64 || self.light_samples + self.bsdf_samples == 0 {
             return Err("--light-samples and --bsdf-samples must be in 0..=64 and not both 0".into());
+        }
+        if self.ris_candidates == 0 || self.ris_candidates > 64 {
+            return Err(format!("--ris-candidates {} is out of range (1..=64)", self.ris_candidates));
         }
         if self.rr_depth == 0 {
             return Err("--rr-depth must be at least 1".into());

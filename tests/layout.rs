@@ -133,7 +133,7 @@ fn shared_structs_match() {
             row_offset,
             row_count,
             offset_scale,
-            _pad0,
+            ris_candidates,
             _pad1,
             _pad2
         ]

@@ -592,6 +592,7 @@ pub fn settings_grid(ui: &mut egui::Ui, settings: &mut [Settings; 2], sides: usi
         drag_row!("power-beta", power_beta, |v| egui::DragValue::new(v).range(0.1..=16.0).speed(0.05));
         combo_row!("mis", mis, MisKind);
         drag_row!("light-samples", light_samples, |v| egui::DragValue::new(v).range(0..=64));
+        drag_row!("ris-candidates", ris_candidates, |v| egui::DragValue::new(v).range(1..=64));
         drag_row!("bsdf-samples", bsdf_samples, |v| egui::DragValue::new(v).range(0..=64));
         combo_row!("sampler", sampler, SamplerKind);
         drag_row!("max-depth", max_depth, |v| egui::DragValue::new(v).range(1..=256));
