@@ -7,13 +7,16 @@
 //! - `area-vs-cosine`: the lecture's slides of a floor under a low area light — light sampling by area (noisy
 //!   near the light: the r⁻² term), cosine sampling (noisy far from it: the light's small solid angle), and MIS.
 //! - `samplers`: each sequence's 2D points and error power spectrum at low spp (`sampler_figure`).
+//! - `many-lights`: the Veach scene with its lights as 80,640 triangles (`veach-mis-triangles`) under MIS with
+//!   uniform, power, light-tree and RIS light selection, at equal time (`--time` per panel, default 4 s): which
+//!   light a sample picks decides the noise.
 
 use crate::film::{Film, Tonemap};
 use crate::gpu::GpuContext;
 use crate::gpu_scene::{GpuScene, SceneData};
 use crate::render::Renderer;
 use crate::scene::{self, LoadOptions};
-use crate::settings::{Heuristic, LightSampling, Settings, Strategy};
+use crate::settings::{Heuristic, LightSampling, LightSelect, Settings, Strategy};
 use std::path::PathBuf;
 
 /// `mislab figure WHICH -o OUT.png`: one of the lecture's figures as a labelled PNG.
@@ -37,10 +40,14 @@ pub struct FigureArgs {
     /// Seed of every random number (the same for every panel).
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Seconds of rendering per panel, instead of --spp (the many-lights figure compares at equal time: 4 s
+    /// unless given).
+    #[arg(long)]
+    pub time: Option<f64>,
 }
 
 /// Names accepted by `FigureArgs::which`.
-pub const FIGURES: &[&str] = &["veach", "area-vs-cosine", "samplers"];
+pub const FIGURES: &[&str] = &["veach", "area-vs-cosine", "samplers", "many-lights"];
 
 /// Gap between panels, pixels.
 const GAP: u32 = 4;
@@ -84,6 +91,19 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
                 Panel { label: "MIS", settings: with(Strategy::Mis) },
             ],
         )),
+        "many-lights" => Ok((
+            "veach-mis-triangles",
+            2,
+            [
+                (LightSelect::Uniform, "uniform"),
+                (LightSelect::Power, "power"),
+                (LightSelect::Tree, "light tree"),
+                (LightSelect::Ris, "RIS"),
+            ]
+            .into_iter()
+            .map(|(light_select, label)| Panel { label, settings: Settings { light_select, ..with(Strategy::Mis) } })
+            .collect(),
+        )),
         "samplers" => Err("figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into()),
         other => Err(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", "))),
     }
@@ -106,6 +126,12 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());
     }
+    let time = args.time.or((args.which == "many-lights").then_some(4.0));
+    if let Some(t) = time {
+        if !(t.is_finite() && t > 0.0 && t <= 3600.0) {
+            return Err(format!("--time {t} must be a number of seconds in (0, 3600]"));
+        }
+    }
     let base = Settings { width: args.width, height: args.height, seed: args.seed, ..Settings::default() };
     let (scene_name, columns, panels) = layout(&args.which, &base)?;
     base.validate()?;
@@ -116,11 +142,18 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
     let mut images = Vec::new();
     for p in &panels {
         renderer.set_settings(p.settings.clone())?;
-        let film = render(&ctx, &mut renderer, args.spp)?;
+        let film = match time {
+            Some(t) => render_for(&ctx, &mut renderer, t)?,
+            None => render(&ctx, &mut renderer, args.spp)?,
+        };
         let mut img = film.to_rgb8(p.settings.exposure, Tonemap::Clamp);
         let scale = if args.width >= 192 { 2 } else { 1 };
         draw_label(&mut img, 4, 4, p.label, scale);
-        draw_label(&mut img, 4, 4 + 9 * scale, &format!("{} spp", args.spp), scale);
+        let budget = match time {
+            Some(t) => format!("{t} s: {} spp", renderer.samples()),
+            None => format!("{} spp", args.spp),
+        };
+        draw_label(&mut img, 4, 4 + 9 * scale, &budget, scale);
         images.push(img);
     }
     let rows = (images.len() as u32).div_ceil(columns);
@@ -134,6 +167,24 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
         image::imageops::replace(&mut out, img, (cx * (args.width + GAP)) as i64, (cy * (args.height + GAP)) as i64);
     }
     save_png(&out, &args.output)
+}
+
+/// Renders whole samples per pixel until `seconds` of rendering have passed (the first pass is timed apart from
+/// the pipeline's compilation by a one-sample warm-up that is discarded), and reads the film back.
+fn render_for(ctx: &GpuContext, renderer: &mut Renderer, seconds: f64) -> Result<Film, String> {
+    render(ctx, renderer, 1)?;
+    renderer.set_settings(renderer.settings().clone())?;
+    let start = std::time::Instant::now();
+    let mut step = 1;
+    while start.elapsed().as_secs_f64() < seconds {
+        let t = std::time::Instant::now();
+        renderer.render(ctx, step)?;
+        // Batches of about a tenth of the budget: few submissions, little overshoot.
+        if t.elapsed().as_secs_f64() < seconds / 20.0 {
+            step = (step * 2).min(1 << 16);
+        }
+    }
+    renderer.film(ctx).map_err(|e| e.to_string())
 }
 
 /// Renders `spp` samples per pixel and reads the film back.

@@ -14,6 +14,9 @@ pub struct BenchArgs {
     /// Samples per pixel of a reference rendered here.
     #[arg(long, default_value_t = 4096)]
     pub ref_spp: u32,
+    /// Light selection of a reference rendered here (the light tree converges fastest with many lights).
+    #[arg(long, value_enum, default_value_t = LightSelect::Uniform)]
+    pub ref_light_select: LightSelect,
     /// Configurations from a TOML file (`[[group]]` tables with the fields of the flags; see docs/samplers.md).
     #[arg(long)]
     pub config: Option<PathBuf>,
@@ -131,6 +134,7 @@ impl BenchArgs {
                 env_rotation: self.scene.env_rotation,
                 reference: self.reference.clone(),
                 reference_spp: self.ref_spp,
+                reference_light_select: self.ref_light_select,
                 mode: self.mode,
                 width: self.width.unwrap_or(512),
                 height: self.height.unwrap_or(512),

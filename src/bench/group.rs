@@ -24,6 +24,9 @@ pub struct BenchGroup {
     pub reference: Option<PathBuf>,
     /// spp of a reference rendered here.
     pub reference_spp: u32,
+    /// Light selection of a reference rendered here (any is unbiased; the light tree converges fastest where
+    /// there are many lights).
+    pub reference_light_select: LightSelect,
     /// direct or path.
     pub mode: Mode,
     /// Film width.
@@ -69,6 +72,7 @@ impl Default for BenchGroup {
             env_rotation: 0.0,
             reference: None,
             reference_spp: 4096,
+            reference_light_select: LightSelect::Uniform,
             mode: Mode::Direct,
             width: 512,
             height: 512,

@@ -52,10 +52,11 @@ fn group_reference(
         height: g.height,
         mode: g.mode,
         max_depth: g.max_depth,
+        light_select: g.reference_light_select,
         ..Settings::default()
     });
     let key = format!(
-        "{}-{}{}-{}x{}-d{}-{}spp",
+        "{}-{}{}-{}x{}-d{}-{}spp{}",
         slug(Path::new(&g.scene).file_stem().and_then(|s| s.to_str()).unwrap_or(&g.scene)),
         g.mode.name(),
         g.env
@@ -65,7 +66,11 @@ fn group_reference(
         g.width,
         g.height,
         g.max_depth,
-        g.reference_spp
+        g.reference_spp,
+        match g.reference_light_select {
+            LightSelect::Uniform => String::new(),
+            other => format!("-{other}"),
+        }
     );
     let path = refs.join(format!("{key}.exr"));
     if path.exists() {

@@ -46,6 +46,22 @@ pub fn lecture_suite(
             ..base.clone()
         },
         BenchGroup {
+            name: "Many lights: uniform vs power vs tree vs RIS (veach-mis-triangles: 80,640 emitters, MIS)".into(),
+            scene: "veach-mis-triangles".into(),
+            strategies: vec![Strategy::Mis],
+            light_selects: LightSelect::ALL.to_vec(),
+            reference_light_select: LightSelect::Tree,
+            ..base.clone()
+        },
+        BenchGroup {
+            name: "Many lights: uniform vs power vs tree vs RIS (many-lights: 4,096 emitters, MIS)".into(),
+            scene: "many-lights".into(),
+            strategies: vec![Strategy::Mis],
+            light_selects: LightSelect::ALL.to_vec(),
+            reference_light_select: LightSelect::Tree,
+            ..base.clone()
+        },
+        BenchGroup {
             name: "MIS: balance vs power heuristic (veach-mis)".into(),
             scene: "veach-mis".into(),
             strategies: vec![Strategy::Mis],

@@ -4,7 +4,8 @@ use super::{Camera, Environment, Material, Mesh, Quad, Scene, Sphere};
 use glam::Vec3;
 
 /// Names of the built-in scenes; the first is the renderer's default.
-pub const NAMES: &[&str] = &["veach-mis", "cornell-box", "furnace", "area-vs-cosine"];
+pub const NAMES: &[&str] =
+    &["veach-mis", "cornell-box", "furnace", "area-vs-cosine", "many-lights", "veach-mis-triangles"];
 
 /// A built-in scene by name, or None for an unknown name.
 pub fn by_name(name: &str) -> Option<Scene> {
@@ -13,25 +14,27 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "cornell-box" => cornell_box(),
         "furnace" => furnace(),
         "area-vs-cosine" => area_vs_cosine(),
+        "many-lights" => super::many_lights::many_lights(),
+        "veach-mis-triangles" => super::many_lights::veach_mis_triangles(),
         _ => return None,
     };
     Some(scene)
 }
 
 /// Collects materials and hands out their indices while a scene is being built.
-struct Builder {
-    scene: Scene,
+pub(super) struct Builder {
+    pub(super) scene: Scene,
 }
 
 impl Builder {
-    fn new(name: &str, camera: Camera) -> Self {
+    pub(super) fn new(name: &str, camera: Camera) -> Self {
         Builder { scene: Scene { name: name.into(), camera, ..Default::default() } }
     }
-    fn material(&mut self, m: Material) -> u32 {
+    pub(super) fn material(&mut self, m: Material) -> u32 {
         self.scene.materials.push(m);
         (self.scene.materials.len() - 1) as u32
     }
-    fn quad(&mut self, corner: Vec3, edge_u: Vec3, edge_v: Vec3, material: u32) {
+    pub(super) fn quad(&mut self, corner: Vec3, edge_u: Vec3, edge_v: Vec3, material: u32) {
         self.scene.quads.push(Quad { corner, edge_u, edge_v, material });
     }
     fn sphere(&mut self, center: Vec3, radius: f32, material: u32) {

@@ -4,6 +4,7 @@
 pub mod builtin;
 pub mod envmap;
 pub mod gltf;
+pub mod many_lights;
 pub mod spec;
 pub mod toml;
 
