@@ -94,6 +94,32 @@ impl Bvh {
     }
 }
 
+/// Renumbers the triangles in the order the leaves reference them. Returns `order` with `order[new] = old` over
+/// all `tri_count` triangles (those the tree excludes, degenerate ones, go last): the caller permutes every
+/// per-triangle array by it. In a triangle-only scene `prim_refs[j] == j` afterwards, so traversal reads a leaf's
+/// triangles directly (`shaders/bvh.wgsl`: three vertex loads per test instead of four); in mixed scenes the
+/// triangle references are rewritten to the new indices.
+pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
+    let mut new_of_old = vec![INVALID; tri_count];
+    let mut order = Vec::with_capacity(tri_count);
+    for r in bvh.prim_refs.iter_mut() {
+        if *r >> PRIM_KIND_SHIFT == PRIM_TRIANGLE {
+            let old = (*r & PRIM_INDEX_MASK) as usize;
+            if new_of_old[old] == INVALID {
+                new_of_old[old] = order.len() as u32;
+                order.push(old as u32);
+            }
+            *r = make_prim(PRIM_TRIANGLE, new_of_old[old]);
+        }
+    }
+    for (old, n) in new_of_old.iter().enumerate() {
+        if *n == INVALID {
+            order.push(old as u32);
+        }
+    }
+    order
+}
+
 /// An axis-aligned box (f32, as uploaded).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {

@@ -6,6 +6,10 @@ use std::time::Duration;
 /// How long any single wait on the device may take before we give up (lavapipe has no watchdog).
 pub const DEVICE_WAIT_TIMEOUT: Duration = Duration::from_secs(120);
 
+/// How long the first dispatch of a new pipeline may take: lavapipe compiles a pipeline at its first use, and
+/// Mesa 25.0's compile of the generic (unspecialised) render kernel alone took over 120 s on 2 busy cores.
+pub const PIPELINE_COMPILE_TIMEOUT: Duration = Duration::from_secs(900);
+
 /// Why no GPU context could be made. The CLI maps every variant to exit code 2.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
@@ -163,8 +167,13 @@ impl GpuContext {
 
     /// Waits for all submitted work, at most `DEVICE_WAIT_TIMEOUT`.
     pub fn wait(&self) -> Result<(), GpuError> {
+        self.wait_at_most(DEVICE_WAIT_TIMEOUT)
+    }
+
+    /// Waits for all submitted work, at most `timeout`.
+    pub fn wait_at_most(&self, timeout: Duration) -> Result<(), GpuError> {
         self.device
-            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(DEVICE_WAIT_TIMEOUT) })
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(timeout) })
             .map(|_| ())
             .map_err(|e| GpuError::Poll(e.to_string()))
     }

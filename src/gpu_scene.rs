@@ -151,7 +151,12 @@ impl SceneData {
             }
         }
         d.offset_scale = if extent.is_finite() && extent > 0.0 { extent.clamp(1e-30, 1.0) } else { 1.0 };
-        let bvh = bvh::build(&tris, &d.spheres, &d.quads);
+        let mut bvh = bvh::build(&tris, &d.spheres, &d.quads);
+        // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs.
+        let order = bvh::into_leaf_order(&mut bvh, tris.len());
+        tris = order.iter().map(|&i| tris[i as usize]).collect();
+        d.tri_verts = order.iter().flat_map(|&i| d.tri_verts[3 * i as usize..3 * i as usize + 3].to_vec()).collect();
+        d.tri_shading = order.iter().map(|&i| d.tri_shading[i as usize]).collect();
         d.bvh_seconds = bvh.build_seconds;
         d.bvh_sah = bvh.sah_cost;
         d.bvh_nodes = bvh.nodes;

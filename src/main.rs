@@ -307,6 +307,18 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             data.bvh_sah,
             data.bvh_bytes()
         );
+        // Device memory per triangle: BVH (nodes + references), geometry (vertices) and per-triangle shading data.
+        let tris = data.tri_shading.len().max(1) as f64;
+        let sizes = mislab::gpu_scene::binding_sizes(&data);
+        let (bvh, geom, shading) = (sizes[0] + sizes[1], sizes[2], sizes[5]);
+        println!(
+            "memory per triangle: BVH {:.0} B, geometry {:.0} B, shading {:.0} B, total {:.0} B; every scene buffer {:.1} MiB",
+            bvh as f64 / tris,
+            geom as f64 / tris,
+            shading as f64 / tris,
+            (bvh + geom + shading) as f64 / tris,
+            sizes.iter().sum::<u64>() as f64 / (1u64 << 20) as f64
+        );
         let features = mislab::features::Features::of(&data);
         println!("features (code paths compiled into its specialised pipelines): {}", features.describe());
     }

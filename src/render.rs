@@ -97,6 +97,8 @@ pub struct Renderer {
     features: Features,
     /// Whether pipelines are specialised to the settings (headless) or read them at run time (viewer).
     specialize: bool,
+    /// The pipeline `warm_up` last ran (compiled on the driver), if any.
+    warmed: Option<PipelineKey>,
     scene_group: wgpu::BindGroup,
     frame_group: wgpu::BindGroup,
     params_buffer: wgpu::Buffer,
@@ -227,6 +229,7 @@ impl Renderer {
             pipelines: PipelineCache::default(),
             features: Features::of(d),
             specialize: true,
+            warmed: None,
             scene_group,
             frame_group,
             params_buffer,
@@ -339,7 +342,9 @@ impl Renderer {
         let mut enc = self.device.create_command_encoder(&Default::default());
         self.record_warm_up(&mut enc);
         self.queue.submit([enc.finish()]);
-        ctx.wait()
+        ctx.wait_at_most(crate::gpu::PIPELINE_COMPILE_TIMEOUT)?;
+        self.warmed = Some(self.key());
+        Ok(())
     }
 
     /// Records a zero-sample dispatch of the current pipeline (see `warm_up`); the caller submits and waits.
@@ -555,6 +560,11 @@ impl Renderer {
     /// `max_dispatch_spp()` samples, one submission each, one wait at the end.
     pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), String> {
         self.prepare()?;
+        // The compile of a pipeline's first use gets its own, longer wait (see PIPELINE_COMPILE_TIMEOUT), so the
+        // device timeout below bounds sample work only.
+        if self.warmed != Some(self.key()) {
+            self.warm_up(ctx).map_err(|e| e.to_string())?;
+        }
         // lavapipe (Mesa 22.3) gives each invocation one budget of 65535 loop iterations shared by all
         // its loops and silently stops looping when it is spent: a 1024-spp dispatch accumulated only
         // ~300-450 samples. Split into small dispatches (one submit each, so each sees its own

@@ -621,6 +621,34 @@ fn build_invariants() {
     );
 }
 
+/// Leaf order (what the renderer uploads): after `into_leaf_order` a triangle-only tree references triangle j at
+/// `prim_refs[j]` (the shader's triangle-only path reads leaves without `prim_refs`), `order` is a permutation, and
+/// the permuted geometry is the same tree (same structure, same closest hits as the reference, by triangle).
+#[test]
+fn leaf_order_makes_triangle_refs_the_identity() {
+    let g = helmet();
+    let mut b = g.build();
+    let order = mislab::bvh::into_leaf_order(&mut b, g.tris.len());
+    assert!(b.prim_refs.iter().enumerate().all(|(j, &r)| r == j as u32), "prim_refs[j] == j");
+    let mut seen = vec![false; g.tris.len()];
+    order.iter().for_each(|&o| seen[o as usize] = true);
+    assert!(order.len() == g.tris.len() && seen.iter().all(|&s| s), "order is a permutation");
+    let permuted = Geometry { tris: order.iter().map(|&o| g.tris[o as usize]).collect(), ..g };
+    check_structure(&permuted, &b);
+    // Mixed kinds: triangle references are rewritten, the others kept.
+    let soup = soup(2);
+    let mut b = soup.build();
+    let before = b.prim_refs.clone();
+    let order = mislab::bvh::into_leaf_order(&mut b, soup.tris.len());
+    for (x, y) in before.iter().zip(&b.prim_refs) {
+        if x >> 30 == 0 {
+            assert_eq!(order[*y as usize], *x, "a triangle reference names the same triangle");
+        } else {
+            assert_eq!(x, y, "sphere and quad references unchanged");
+        }
+    }
+}
+
 #[test]
 fn build_edge_cases() {
     // Empty, all-excluded, one primitive, two primitives.
