@@ -177,3 +177,65 @@ impl Builder {
         self.scene
     }
 }
+
+/// Segments of a disk's triangle fan.
+const DISK_SEGMENTS: usize = 64;
+
+/// A disk at z = `height` facing +z (−z when `reverse`), as a fan whose area is the disk's.
+pub fn disk(radius: f32, height: f32, reverse: bool) -> ObjectMesh {
+    let n = DISK_SEGMENTS as f32;
+    let tau = 2.0 * std::f32::consts::PI;
+    // A regular n-gon of circumradius r has area n r² sin(2π/n) / 2: scale r so it equals π r².
+    let r = radius * (tau / (n * (tau / n).sin())).sqrt();
+    let mut positions = vec![Vec3::new(0.0, 0.0, height)];
+    let mut uvs = vec![Vec2::ZERO];
+    for i in 0..DISK_SEGMENTS {
+        let phi = tau * i as f32 / n;
+        positions.push(Vec3::new(r * phi.cos(), r * phi.sin(), height));
+        uvs.push(Vec2::new(i as f32 / n, 1.0));
+    }
+    let normal = if reverse { Vec3::NEG_Z } else { Vec3::Z };
+    let normals = vec![normal; positions.len()];
+    let k = DISK_SEGMENTS as u32;
+    let indices = (0..k).map(|i| [0, 1 + i, 1 + (i + 1) % k]).collect();
+    ObjectMesh { name: "disk".into(), positions, normals, uvs, indices }
+}
+
+/// Mitsuba's `rectangle`: [−1, 1]² at z = 0 facing +z.
+pub fn rectangle() -> ObjectMesh {
+    let positions = vec![
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    ];
+    let uvs = vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
+    ObjectMesh {
+        name: "rectangle".into(),
+        positions,
+        normals: vec![Vec3::Z; 4],
+        uvs,
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+    }
+}
+
+/// Mitsuba's `cube`: [−1, 1]³ with outward faces.
+pub fn cube() -> ObjectMesh {
+    let mut m = ObjectMesh { name: "cube".into(), positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = sign;
+            let (u, v) = (n.any_orthonormal_pair().0, n.any_orthonormal_pair().1);
+            let base = m.positions.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                m.positions.push(n + u * a + v * b);
+                m.normals.push(n);
+                m.uvs.push(Vec2::new((a + 1.0) / 2.0, (b + 1.0) / 2.0));
+            }
+            m.indices.push([base, base + 1, base + 2]);
+            m.indices.push([base, base + 2, base + 3]);
+        }
+    }
+    m
+}

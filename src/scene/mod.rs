@@ -9,6 +9,7 @@ pub mod import_build;
 pub mod import_material;
 pub mod import_texture;
 pub mod mitsuba;
+pub mod obj;
 pub mod pbrt;
 pub mod pfm;
 pub mod ply;

@@ -8,9 +8,6 @@ use crate::scene::SceneError;
 use glam::{Vec2, Vec3};
 use std::path::Path;
 
-/// Segments of a disk's triangle fan.
-const DISK_SEGMENTS: usize = 64;
-
 fn vec3s(v: Vec<f64>) -> Vec<Vec3> {
     v.chunks_exact(3).map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)).collect()
 }
@@ -62,22 +59,7 @@ pub fn ply_mesh(p: &Params, dir: &Path) -> Result<ObjectMesh, SceneError> {
     Ok(ObjectMesh { name: file, positions: m.positions, normals: m.normals, uvs: m.uvs, indices: m.indices })
 }
 
-/// `disk` at z = `height` facing +z (−z when `reverse`), as a fan with the disk's area.
+/// `disk` at z = `height` facing +z (−z when `reverse`).
 pub fn disk(p: &Params, reverse: bool) -> Result<ObjectMesh, SceneError> {
-    let radius = p.float("radius", 1.0)?;
-    let height = p.float("height", 0.0)?;
-    let n = DISK_SEGMENTS as f32;
-    // A regular n-gon of circumradius r has area n r² sin(2π/n) / 2: scale r so it equals π r².
-    let r = radius * (2.0 * std::f32::consts::PI / (n * (2.0 * std::f32::consts::PI / n).sin())).sqrt();
-    let mut positions = vec![Vec3::new(0.0, 0.0, height)];
-    let mut uvs = vec![Vec2::ZERO];
-    for i in 0..DISK_SEGMENTS {
-        let phi = 2.0 * std::f32::consts::PI * i as f32 / n;
-        positions.push(Vec3::new(r * phi.cos(), r * phi.sin(), height));
-        uvs.push(Vec2::new(i as f32 / n, 1.0));
-    }
-    let normal = if reverse { Vec3::NEG_Z } else { Vec3::Z };
-    let normals = vec![normal; positions.len()];
-    let indices = (0..DISK_SEGMENTS as u32).map(|i| [0, 1 + i, 1 + (i + 1) % DISK_SEGMENTS as u32]).collect();
-    Ok(ObjectMesh { name: "disk".into(), positions, normals, uvs, indices })
+    Ok(crate::scene::import_build::disk(p.float("radius", 1.0)?, p.float("height", 0.0)?, reverse))
 }
