@@ -2,6 +2,7 @@
 //! as pbrt and Tungsten store environment maps. Rows are stored bottom to top; we return them top row first.
 
 /// A decoded PFM: width, height and RGB texels, top row first.
+#[derive(Debug)]
 pub struct Pfm {
     /// Width.
     pub width: u32,

@@ -2,6 +2,7 @@
 //! of the Bitterli scenes' textures, decoded to RGBA8 top row first.
 
 /// A decoded TGA: width, height, RGBA8 texels top row first.
+#[derive(Debug)]
 pub struct Tga {
     /// Width.
     pub width: u32,
