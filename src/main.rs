@@ -162,7 +162,7 @@ fn stress(filter: Option<&str>) -> Result<u8, Failure> {
 }
 
 fn render(args: RenderArgs) -> Result<u8, Failure> {
-    let settings = args.settings.clone();
+    let mut settings = args.settings.clone();
     settings.validate().map_err(bad)?;
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if !matches!(ext.as_deref(), Some("png") | Some("exr")) {
@@ -193,6 +193,14 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     }
     // The scene first: a bad file is reported without waiting for (or needing) a device.
     let scene = load_scene(&args.scene)?;
+    // A pbrt Film / Mitsuba hdrfilm size is the default: used when --width and --height are both left at theirs.
+    let default = Settings::default();
+    if let (Some([w, h]), true) =
+        (scene.film_size, settings.width == default.width && settings.height == default.height)
+    {
+        eprintln!("note: image size {w}x{h} from the scene file (--width/--height override it)");
+        (settings.width, settings.height) = (w, h);
+    }
     let t_loaded = Instant::now();
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
@@ -284,6 +292,9 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
     if let Some(name) = scene_name {
         let scene = load_scene(&SceneSpec::named(&name))?;
         let data = SceneData::build(&scene);
+        for line in &scene.import_report {
+            println!("{line}");
+        }
         println!(
             "scene {}: {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights ({} delta), environment: {}",
             scene.name,

@@ -2,10 +2,21 @@
 //! downstream (BVH, GPU upload, features) consumes. World space, right-handed, +Y up, linear Rec.709 RGB.
 
 pub mod builtin;
+pub mod env_import;
 pub mod envmap;
 pub mod gltf;
+pub mod import_build;
+pub mod import_material;
+pub mod import_texture;
 pub mod many_lights;
+pub mod mitsuba;
+pub mod obj;
+pub mod pbrt;
+pub mod pfm;
+pub mod ply;
+pub mod read_input;
 pub mod spec;
+pub mod tga;
 pub mod toml;
 
 pub use spec::SceneSpec;
@@ -290,6 +301,10 @@ pub struct Scene {
     pub environment: Environment,
     /// Things that were skipped or repaired while loading, one line each (printed once by the CLI).
     pub warnings: Vec<String>,
+    /// The image size the file asks for (pbrt `Film`, Mitsuba `hdrfilm`), used when none is given.
+    pub film_size: Option<[u32; 2]>,
+    /// pbrt / Mitsuba imports: what was imported and what was ignored, one line each (`mislab info`).
+    pub import_report: Vec<String>,
 }
 
 impl Scene {
@@ -332,7 +347,12 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
     let result = catch_quietly(|| match ext.as_str() {
         "gltf" | "glb" => gltf::load(path, options),
         "toml" => toml::load(path, options),
-        _ => Err(SceneError::new(path, format!("unknown scene format '.{ext}' (expected .gltf, .glb or .toml)"))),
+        "pbrt" => pbrt::load(path),
+        "xml" => mitsuba::load(path),
+        _ => Err(SceneError::new(
+            path,
+            format!("unknown scene format '.{ext}' (expected .gltf, .glb, .toml, .pbrt or Mitsuba .xml)"),
+        )),
     });
     match result {
         Ok(r) => r,

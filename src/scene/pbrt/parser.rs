@@ -1,0 +1,681 @@
+//! pbrt-v4 directives and graphics state: transforms, attribute stacks, named materials and textures, area
+//! lights, object instancing (flattened into triangles), Include/Import (with circular-include detection),
+//! camera, film and lights.
+
+use super::params::{self, Params, Values};
+use super::shapes;
+use super::tokenizer::{tokenize, Tok, Token};
+use crate::scene::env_import::{self, Layout};
+use crate::scene::import_build::{Builder, ObjectMesh};
+use crate::scene::import_material::{MatParam, MaterialDesc, TexDesc};
+use crate::scene::read_input::read_bytes;
+use crate::scene::{Camera, Environment, PunctualLight, Scene, SceneError};
+use glam::{DMat4, DVec3, Mat3, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::sync::Arc;
+
+/// pbrt's world → mislab's. The identity: with pbrt's camera frame taken as (x right, y up, z forward) the
+/// Bitterli scenes render unmirrored against their references (checked on living-room's TungstenRender.png).
+const MIRROR: DMat4 = DMat4::IDENTITY;
+
+/// Nesting depth of Include / Import beyond which a file is refused.
+const MAX_INCLUDE_DEPTH: usize = 32;
+
+/// Height of the lat-long map an environment is resampled into.
+const ENV_HEIGHT: u32 = 512;
+
+#[derive(Clone)]
+struct AreaLight {
+    radiance: Vec3,
+}
+
+#[derive(Clone)]
+struct State {
+    ctm: DMat4,
+    reverse: bool,
+    material: usize,
+    area: Option<AreaLight>,
+}
+
+/// A shape with the state it was declared in (kept for object instances).
+#[derive(Clone)]
+struct ShapeCall {
+    kind: String,
+    params: Rc<Params>,
+    ctm: DMat4,
+    reverse: bool,
+    material: usize,
+    area: Option<AreaLight>,
+}
+
+#[derive(PartialEq)]
+enum Scope {
+    Attribute,
+    Transform,
+    Object,
+}
+
+/// The parser and everything it has built so far.
+pub struct Parser {
+    main: PathBuf,
+    dir: PathBuf,
+    b: Builder,
+    gs: State,
+    stack: Vec<(State, Scope, PathBuf, usize)>,
+    named_materials: HashMap<String, usize>,
+    textures: HashMap<String, MatParam>,
+    objects: HashMap<String, Vec<ShapeCall>>,
+    object: Option<(String, Vec<ShapeCall>)>,
+    includes: Vec<PathBuf>,
+    camera: Option<(DMat4, f64)>,
+    film: [u32; 2],
+    env_lights: usize,
+}
+
+impl Parser {
+    /// A parser for the file at `main` (relative paths in it resolve against its directory, as in pbrt).
+    pub fn new(main: &Path) -> Parser {
+        let mut b = Builder::default();
+        let default = b.add_desc(MaterialDesc {
+            name: "pbrt default (diffuse 0.5)".into(),
+            kind: "diffuse".into(),
+            params: Default::default(),
+        });
+        Parser {
+            main: main.to_path_buf(),
+            dir: main.parent().map(Path::to_path_buf).unwrap_or_default(),
+            b,
+            gs: State { ctm: DMat4::IDENTITY, reverse: false, material: default, area: None },
+            stack: vec![],
+            named_materials: HashMap::new(),
+            textures: HashMap::new(),
+            objects: HashMap::new(),
+            object: None,
+            includes: vec![],
+            camera: None,
+            film: [1280, 720],
+            env_lights: 0,
+        }
+    }
+
+    /// Parses the file and everything it includes, and returns the scene.
+    pub fn run(mut self) -> Result<Scene, SceneError> {
+        let main = self.main.clone();
+        self.file(&main, "")?;
+        if let Some((_, scope, file, line)) = self.stack.last() {
+            let what = match scope {
+                Scope::Attribute => "AttributeBegin",
+                Scope::Transform => "TransformBegin",
+                Scope::Object => "ObjectBegin",
+            };
+            return Err(SceneError::new(file, format!("line {line}: {what} is never closed (is the file truncated?)")));
+        }
+        let [w, h] = self.film;
+        let mut scene_camera = Camera::default();
+        if let Some((camera_from_world, fov)) = self.camera {
+            let wfc = MIRROR * camera_from_world.inverse();
+            let position = wfc.transform_point3(DVec3::ZERO).as_vec3();
+            let forward = wfc.transform_vector3(DVec3::Z).normalize().as_vec3();
+            let up = wfc.transform_vector3(DVec3::Y).normalize().as_vec3();
+            // pbrt's fov spans the shorter image axis; ours is vertical.
+            let half = (fov.to_radians() / 2.0).tan();
+            let vfov = if w >= h { fov.to_radians() } else { 2.0 * (half * h as f64 / w as f64).atan() };
+            scene_camera = Camera { position, forward, up, vfov: vfov as f32 };
+            self.b.count("camera (perspective)", 1);
+        } else {
+            self.b.ignore("no Camera directive: mislab's default camera is used");
+        }
+        self.b.scene.camera = scene_camera;
+        self.b.scene.film_size = Some([w, h]);
+        self.b.scene.name = self.main.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        Ok(self.b.finish("pbrt-v4"))
+    }
+
+    fn file(&mut self, path: &Path, by: &str) -> Result<(), SceneError> {
+        let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        if self.includes.contains(&canonical) {
+            let chain: Vec<String> =
+                self.includes.iter().chain([&canonical]).map(|p| p.display().to_string()).collect();
+            return Err(SceneError::new(path, format!("circular Include ({by}): {}", chain.join(" → "))));
+        }
+        if self.includes.len() >= MAX_INCLUDE_DEPTH {
+            return Err(SceneError::new(path, format!("Include nested more than {MAX_INCLUDE_DEPTH} deep ({by})")));
+        }
+        let bytes = read_bytes(path, by)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            SceneError::new(
+                path,
+                format!("not UTF-8 text (byte {}): is this a pbrt file?", e.utf8_error().valid_up_to()),
+            )
+        })?;
+        let tokens = tokenize(path, &text)?;
+        self.includes.push(canonical);
+        let r = self.tokens(path, &tokens);
+        self.includes.pop();
+        r
+    }
+
+    fn tokens(&mut self, file: &Path, t: &[Token]) -> Result<(), SceneError> {
+        let mut i = 0;
+        while i < t.len() {
+            let line = t[i].line;
+            let err = |m: String| SceneError::new(file, format!("line {line}: {m}"));
+            let Tok::Word(d) = &t[i].tok else {
+                return Err(err(format!("expected a directive, found {:?}", t[i].tok)));
+            };
+            let d = d.clone();
+            i += 1;
+            let nums = |n: usize, i: &mut usize| -> Result<Vec<f64>, SceneError> {
+                let bracket = matches!(t.get(*i).map(|t| &t.tok), Some(Tok::Open));
+                if bracket {
+                    *i += 1;
+                }
+                let mut v = Vec::with_capacity(n);
+                for _ in 0..n {
+                    match t.get(*i).map(|t| &t.tok) {
+                        Some(Tok::Num(x)) => v.push(*x),
+                        _ => return Err(err(format!("{d} expects {n} numbers"))),
+                    }
+                    *i += 1;
+                }
+                if bracket {
+                    if !matches!(t.get(*i).map(|t| &t.tok), Some(Tok::Close)) {
+                        return Err(err(format!("{d} expects {n} numbers in [ ]")));
+                    }
+                    *i += 1;
+                }
+                Ok(v)
+            };
+            let string = |i: &mut usize| -> Result<String, SceneError> {
+                match t.get(*i).map(|t| &t.tok) {
+                    Some(Tok::Str(s)) => {
+                        *i += 1;
+                        Ok(s.clone())
+                    }
+                    _ => Err(err(format!("{d} expects a quoted name"))),
+                }
+            };
+            match d.as_str() {
+                "AttributeBegin" => self.stack.push((self.gs.clone(), Scope::Attribute, file.into(), line)),
+                "TransformBegin" => self.stack.push((self.gs.clone(), Scope::Transform, file.into(), line)),
+                "AttributeEnd" | "TransformEnd" => {
+                    let want = if d == "AttributeEnd" { Scope::Attribute } else { Scope::Transform };
+                    match self.stack.pop() {
+                        Some((s, scope, ..)) if scope == want => {
+                            if want == Scope::Attribute {
+                                self.gs = s;
+                            } else {
+                                self.gs.ctm = s.ctm;
+                            }
+                        }
+                        _ => return Err(err(format!("{d} without a matching {}Begin", &d[..d.len() - 3]))),
+                    }
+                }
+                "WorldBegin" => self.gs.ctm = DMat4::IDENTITY,
+                "WorldEnd" => {}
+                "Identity" => self.gs.ctm = DMat4::IDENTITY,
+                "Translate" => {
+                    let v = nums(3, &mut i)?;
+                    self.gs.ctm *= DMat4::from_translation(DVec3::new(v[0], v[1], v[2]));
+                }
+                "Scale" => {
+                    let v = nums(3, &mut i)?;
+                    self.gs.ctm *= DMat4::from_scale(DVec3::new(v[0], v[1], v[2]));
+                }
+                "Rotate" => {
+                    let v = nums(4, &mut i)?;
+                    let axis = DVec3::new(v[1], v[2], v[3]);
+                    if axis.length_squared() == 0.0 {
+                        return Err(err("Rotate about a zero axis".into()));
+                    }
+                    self.gs.ctm *= DMat4::from_axis_angle(axis.normalize(), v[0].to_radians());
+                }
+                "LookAt" => {
+                    let v = nums(9, &mut i)?;
+                    self.gs.ctm *= look_at(&v).ok_or_else(|| err("LookAt: degenerate eye, target and up".into()))?;
+                }
+                "Transform" | "ConcatTransform" => {
+                    let v = nums(16, &mut i)?;
+                    let m = DMat4::from_cols_array(&v.try_into().expect("16 numbers"));
+                    if d == "Transform" {
+                        self.gs.ctm = m;
+                    } else {
+                        self.gs.ctm *= m;
+                    }
+                }
+                "ReverseOrientation" => self.gs.reverse = !self.gs.reverse,
+                "Include" | "Import" => {
+                    let name = string(&mut i)?;
+                    let path = self.dir.join(&name);
+                    self.file(&path, &format!("{}: line {line}", file.display()))?;
+                }
+                "ObjectBegin" => {
+                    let name = string(&mut i)?;
+                    if self.object.is_some() {
+                        return Err(err("ObjectBegin inside another ObjectBegin".into()));
+                    }
+                    self.stack.push((self.gs.clone(), Scope::Object, file.into(), line));
+                    self.object = Some((name, vec![]));
+                }
+                "ObjectEnd" => {
+                    let Some((name, shapes)) = self.object.take() else {
+                        return Err(err("ObjectEnd without ObjectBegin".into()));
+                    };
+                    match self.stack.pop() {
+                        Some((s, Scope::Object, ..)) => self.gs = s,
+                        _ => return Err(err("ObjectEnd does not close its ObjectBegin".into())),
+                    }
+                    self.objects.insert(name, shapes);
+                }
+                "ObjectInstance" => {
+                    let name = string(&mut i)?;
+                    let Some(shapes) = self.objects.get(&name).cloned() else {
+                        return Err(err(format!("ObjectInstance \"{name}\": no such object (ObjectBegin)")));
+                    };
+                    self.b.count("object instances (flattened)", 1);
+                    for mut s in shapes {
+                        s.ctm = self.gs.ctm * s.ctm;
+                        self.shape(s)?;
+                    }
+                }
+                _ => {
+                    // Directives with a type name and a parameter list.
+                    let has_kind = !matches!(d.as_str(), "Attribute");
+                    let kind = if has_kind { string(&mut i)? } else { String::new() };
+                    let mut extra = None;
+                    if d == "Texture" || d == "MediumInterface" || d == "Attribute" {
+                        // Texture "name" "type" "class"; MediumInterface "in" ["out"]; Attribute "target".
+                        if let Some(Tok::Str(s)) = t.get(i).map(|t| &t.tok) {
+                            if d != "MediumInterface" || !s.contains(' ') {
+                                extra = Some(s.clone());
+                                i += 1;
+                            }
+                        }
+                    }
+                    let mut class = None;
+                    if d == "Texture" {
+                        class = Some(string(&mut i)?);
+                    }
+                    let p = params::parse(file, line, t, &mut i)?;
+                    self.directive(&d, &kind, extra, class, p)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn directive(
+        &mut self,
+        d: &str,
+        kind: &str,
+        extra: Option<String>,
+        class: Option<String>,
+        p: Params,
+    ) -> Result<(), SceneError> {
+        match d {
+            "Camera" => {
+                if kind != "perspective" {
+                    self.b.ignore(format!("Camera \"{kind}\" (rendered as perspective)"));
+                }
+                let fov = p.float("fov", 90.0)? as f64;
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(p.error(format!("Camera fov {fov} is outside (0, 180) degrees")));
+                }
+                self.camera = Some((self.gs.ctm, fov));
+            }
+            "Film" => {
+                let (w, h) = (p.int("xresolution", 1280)?, p.int("yresolution", 720)?);
+                if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+                    return Err(p.error(format!("Film resolution {w}x{h} is out of range (1..=16384 per side)")));
+                }
+                self.film = [w as u32, h as u32];
+                self.b.count("film size (the default image size)", 1);
+                p.has("filename");
+            }
+            "Texture" => self.texture(kind, extra.as_deref().unwrap_or(""), class.as_deref().unwrap_or(""), &p)?,
+            "Material" => {
+                let desc = self.material_desc(&format!("{}:{}", p.file.display(), p.line), kind, &p)?;
+                self.gs.material = self.b.add_desc(desc);
+            }
+            "MakeNamedMaterial" => {
+                let ty = p
+                    .string("type")?
+                    .ok_or_else(|| p.error(format!("MakeNamedMaterial \"{kind}\": no \"string type\"")))?;
+                let desc = self.material_desc(kind, &ty, &p)?;
+                let index = self.b.add_desc(desc);
+                self.named_materials.insert(kind.to_string(), index);
+            }
+            "NamedMaterial" => {
+                self.gs.material = *self.named_materials.get(kind).ok_or_else(|| {
+                    p.error(format!("NamedMaterial \"{kind}\": no such material (MakeNamedMaterial)"))
+                })?;
+            }
+            "AreaLightSource" => {
+                if kind != "diffuse" {
+                    self.b.ignore(format!("AreaLightSource \"{kind}\""));
+                } else {
+                    let l = self.spectrum(&p, "L", Vec3::ONE)?;
+                    let scale = p.float("scale", 1.0)?;
+                    if p.bool("twosided", false)? {
+                        self.b.ignore("AreaLightSource \"twosided\" (emits from the front only)");
+                    }
+                    self.gs.area = Some(AreaLight { radiance: l * scale });
+                }
+            }
+            "LightSource" => self.light(kind, &p)?,
+            "Shape" => {
+                let call = ShapeCall {
+                    kind: kind.into(),
+                    params: Rc::new(p),
+                    ctm: self.gs.ctm,
+                    reverse: self.gs.reverse,
+                    material: self.gs.material,
+                    area: self.gs.area.clone(),
+                };
+                if let Some((_, shapes)) = &mut self.object {
+                    shapes.push(call);
+                } else {
+                    self.shape(call)?;
+                }
+                return Ok(());
+            }
+            "Integrator" | "Sampler" | "PixelFilter" | "Accelerator" | "ColorSpace" | "Option" | "MakeNamedMedium"
+            | "MediumInterface" | "Attribute" | "CoordinateSystem" | "CoordSysTransform" | "TransformTimes"
+            | "ActiveTransform" => {
+                let what = if kind.is_empty() { d.to_string() } else { format!("{d} \"{kind}\"") };
+                self.b.ignore(what);
+                for u in p.unused() {
+                    p.has(u.trim_matches('"').split(' ').nth(1).unwrap_or(""));
+                }
+                return Ok(());
+            }
+            _ => return Err(p.error(format!("unknown directive '{d}'"))),
+        }
+        for u in p.unused() {
+            self.b.ignore(format!("{d} \"{kind}\" parameter {u}"));
+        }
+        Ok(())
+    }
+
+    /// An RGB-valued parameter (`rgb`, `blackbody` approximated as white, named spectra as white).
+    fn spectrum(&mut self, p: &Params, name: &str, default: Vec3) -> Result<Vec3, SceneError> {
+        match p.type_of(name) {
+            Some("rgb") | Some("color") => Ok(p.vec3(name, &["rgb", "color"])?.unwrap_or(default)),
+            Some(ty) => {
+                p.has(name);
+                self.b.ignore(format!("\"{ty} {name}\" spectra (white of the same luminance 1 used)"));
+                Ok(Vec3::ONE)
+            }
+            None => Ok(default),
+        }
+    }
+
+    fn texture(&mut self, name: &str, ty: &str, class: &str, p: &Params) -> Result<(), SceneError> {
+        let value = match class {
+            "imagemap" => {
+                let file = p
+                    .string("filename")?
+                    .ok_or_else(|| p.error(format!("Texture \"{name}\": no \"string filename\"")))?;
+                let path = self.dir.join(&file);
+                if !path.is_file() {
+                    return Err(SceneError::new(
+                        &path,
+                        format!("texture file not found (referenced by {}: line {})", p.file.display(), p.line),
+                    ));
+                }
+                let (us, vs) = (p.float("uscale", 1.0)?, p.float("vscale", 1.0)?);
+                let (ud, vd) = (p.float("udelta", 0.0)?, p.float("vdelta", 0.0)?);
+                let scale = p.float("scale", 1.0)?;
+                let encoding = p.string("encoding")?.unwrap_or_else(|| "sRGB".into());
+                if p.bool("invert", false)? {
+                    self.b.ignore(format!("Texture \"{name}\" \"bool invert\""));
+                }
+                p.has("filter");
+                if ty == "float" {
+                    // Float image textures are used as alpha masks (leaves); cut-outs are not supported yet.
+                    self.b.ignore(format!("float image texture \"{name}\" (alpha cut-outs are not supported)"));
+                }
+                // Stored with v down; our add_mesh already flips v, so the pbrt map (us·u+ud, vs·v+vd) becomes
+                // u' = us·u + ud, v' = vs·v' − vs + 1 − vd in terms of the flipped v' = 1 − v.
+                let uv = [[us, 0.0, ud], [0.0, vs, 1.0 - vs - vd]];
+                MatParam::Texture(TexDesc { file: path, uv, scale: Vec3::splat(scale), srgb: encoding != "linear" })
+            }
+            "scale" => {
+                let base = self.texture_or_value(p, "tex", Vec3::ONE)?;
+                let s = match self.texture_or_value(p, "scale", Vec3::ONE)? {
+                    MatParam::Rgb(c) => c,
+                    MatParam::Float(f) => Vec3::splat(f),
+                    _ => {
+                        self.b.ignore(format!("Texture \"{name}\" \"scale\" by a texture"));
+                        Vec3::ONE
+                    }
+                };
+                match base {
+                    MatParam::Texture(mut t) => {
+                        t.scale *= s;
+                        MatParam::Texture(t)
+                    }
+                    MatParam::Rgb(c) => MatParam::Rgb(c * s),
+                    MatParam::Float(f) => MatParam::Rgb(f * s),
+                    other => other,
+                }
+            }
+            "constant" => self.texture_or_value(p, "value", Vec3::ONE)?,
+            _ => {
+                self.b.ignore(format!("Texture class \"{class}\" (grey 0.5 used)"));
+                MatParam::Rgb(Vec3::splat(0.5))
+            }
+        };
+        for u in p.unused() {
+            self.b.ignore(format!("Texture \"{class}\" parameter {u}"));
+        }
+        self.textures.insert(name.to_string(), value);
+        Ok(())
+    }
+
+    fn texture_or_value(&mut self, p: &Params, name: &str, default: Vec3) -> Result<MatParam, SceneError> {
+        match p.type_of(name) {
+            Some("texture") => {
+                let t = p.string_of(name, &["texture"])?.expect("present");
+                self.textures.get(&t).cloned().ok_or_else(|| p.error(format!("texture \"{t}\" is not defined")))
+            }
+            Some("float") => Ok(MatParam::Float(p.float(name, 1.0)?)),
+            Some(_) => Ok(MatParam::Rgb(self.spectrum(p, name, default)?)),
+            None => Ok(MatParam::Rgb(default)),
+        }
+    }
+
+    /// A material description: every parameter, typed, textures resolved.
+    fn material_desc(&mut self, name: &str, kind: &str, p: &Params) -> Result<MaterialDesc, SceneError> {
+        let mut params = std::collections::BTreeMap::new();
+        for q in &p.list {
+            p.has(&q.name);
+            if q.name == "type" {
+                continue;
+            }
+            let v = match (&q.ty[..], &q.values) {
+                ("texture", Values::Strs(s)) if s.len() == 1 => self
+                    .textures
+                    .get(&s[0])
+                    .cloned()
+                    .ok_or_else(|| p.error_at(q, format!("texture \"{}\" is not defined", s[0])))?,
+                ("float" | "integer", Values::Nums(v)) if v.len() == 1 => MatParam::Float(v[0] as f32),
+                ("rgb" | "color", Values::Nums(v)) if v.len() == 3 => {
+                    MatParam::Rgb(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+                }
+                ("spectrum", Values::Strs(s)) if s.len() == 1 => MatParam::Spectrum(s[0].clone()),
+                ("spectrum" | "blackbody", Values::Nums(_)) => MatParam::Spectrum(format!("{} values", q.ty)),
+                ("string", Values::Strs(s)) if s.len() == 1 => MatParam::Str(s[0].clone()),
+                ("bool", Values::Bools(b)) if b.len() == 1 => MatParam::Bool(b[0]),
+                _ => return Err(p.error_at(q, "wrong type or number of values for a material parameter")),
+            };
+            params.insert(q.name.clone(), v);
+        }
+        Ok(MaterialDesc { name: name.into(), kind: kind.into(), params })
+    }
+
+    fn light(&mut self, kind: &str, p: &Params) -> Result<(), SceneError> {
+        let to_world = MIRROR * self.gs.ctm;
+        let scale = p.float("scale", 1.0)?;
+        if p.has("power") || p.has("illuminance") {
+            self.b.ignore(format!("LightSource \"{kind}\" \"power\"/\"illuminance\" (scale and L/I are used)"));
+        }
+        let point = |v: Option<Vec3>, d: Vec3| to_world.transform_point3(v.unwrap_or(d).as_dvec3()).as_vec3();
+        match kind {
+            "point" => {
+                let i = self.spectrum(p, "I", Vec3::ONE)? * scale;
+                let position = point(p.vec3("from", &["point3", "point"])?, Vec3::ZERO);
+                self.b.scene.punctual_lights.push(PunctualLight::Point { position, intensity: i });
+            }
+            "spot" => {
+                let i = self.spectrum(p, "I", Vec3::ONE)? * scale;
+                let from = point(p.vec3("from", &["point3", "point"])?, Vec3::ZERO);
+                let to = point(p.vec3("to", &["point3", "point"])?, Vec3::Z);
+                let cone = p.float("coneangle", 30.0)?.to_radians();
+                let delta = p.float("conedelta", 5.0)?.to_radians();
+                self.b.scene.punctual_lights.push(PunctualLight::Spot {
+                    position: from,
+                    direction: (to - from).normalize_or(Vec3::NEG_Y),
+                    intensity: i,
+                    inner_cone: (cone - delta).max(0.0),
+                    outer_cone: cone,
+                });
+            }
+            "distant" => {
+                let l = self.spectrum(p, "L", Vec3::ONE)? * scale;
+                let from = p.vec3("from", &["point3", "point"])?.unwrap_or(Vec3::ZERO);
+                let to = p.vec3("to", &["point3", "point"])?.unwrap_or(Vec3::Z);
+                let dir = to_world.transform_vector3((to - from).as_dvec3()).as_vec3();
+                if dir.length_squared() == 0.0 {
+                    return Err(p.error("LightSource \"distant\": \"from\" and \"to\" are the same point"));
+                }
+                self.b
+                    .scene
+                    .punctual_lights
+                    .push(PunctualLight::Directional { direction: dir.normalize(), irradiance: l });
+            }
+            "infinite" => {
+                self.env_lights += 1;
+                if self.env_lights > 1 {
+                    self.b.ignore("a second LightSource \"infinite\" (mislab has one environment)");
+                    for u in p.unused() {
+                        p.has(u.trim_matches('"').split(' ').nth(1).unwrap_or(""));
+                    }
+                    return Ok(());
+                }
+                let light_from_world = Mat3::from_mat4(to_world.as_mat4()).inverse();
+                if let Some(file) = p.string("filename")? {
+                    let path = self.dir.join(&file);
+                    let by = format!("{}: line {}", p.file.display(), p.line);
+                    let (w, h, texels) = load_float_image(&path, &by)?;
+                    if w != h {
+                        self.b.ignore("a non-square infinite light map (read as lat-long)");
+                    }
+                    let layout = if w == h { Layout::EqualArea } else { Layout::Equirect };
+                    let map = env_import::resample(path, &texels, w, h, layout, light_from_world, ENV_HEIGHT);
+                    self.b.scene.environment = Environment::Map { map: Arc::new(map), scale, rotation: 0.0 };
+                    p.has("L");
+                } else {
+                    let l = self.spectrum(p, "L", Vec3::ONE)? * scale;
+                    self.b.scene.environment = Environment::Constant(l);
+                }
+                p.has("portal");
+            }
+            _ => {
+                self.b.ignore(format!("LightSource \"{kind}\""));
+                for u in p.unused() {
+                    p.has(u.trim_matches('"').split(' ').nth(1).unwrap_or(""));
+                }
+                return Ok(());
+            }
+        }
+        self.b.count(&format!("{kind} lights"), 1);
+        Ok(())
+    }
+
+    fn shape(&mut self, s: ShapeCall) -> Result<(), SceneError> {
+        let p = &*s.params;
+        let emission = s.area.as_ref().map_or(Vec3::ZERO, |a| a.radiance);
+        if p.has("alpha") {
+            self.b.ignore("shape \"alpha\" cut-outs");
+        }
+        let to_world = (MIRROR * s.ctm).as_mat4();
+        let flip = s.reverse ^ (Mat3::from_mat4(to_world).determinant() < 0.0);
+        let mesh: Option<ObjectMesh> = match s.kind.as_str() {
+            "trianglemesh" => Some(shapes::inline_mesh(p, "trianglemesh", false)?),
+            "bilinearmesh" => Some(shapes::inline_mesh(p, "bilinearmesh", true)?),
+            "plymesh" => {
+                if p.has("displacement") || p.has("edgelength") {
+                    self.b.ignore("plymesh displacement");
+                }
+                Some(shapes::ply_mesh(p, &self.dir)?)
+            }
+            "disk" => {
+                if p.float("innerradius", 0.0)? > 0.0 || p.float("phimax", 360.0)? < 360.0 {
+                    self.b.ignore("partial disks (rendered whole)");
+                }
+                Some(shapes::disk(p, s.reverse)?)
+            }
+            "sphere" => None,
+            other => {
+                self.b.ignore(format!("Shape \"{other}\""));
+                return Ok(());
+            }
+        };
+        let Some(material) = self.b.material(s.material, emission)? else {
+            self.b.invisible_shapes += 1;
+            return Ok(());
+        };
+        match mesh {
+            Some(m) => self.b.add_mesh(m, to_world, flip, material),
+            None => {
+                let radius = p.float("radius", 1.0)?;
+                if !(radius > 0.0) {
+                    return Err(p.error(format!("sphere radius {radius} must be > 0")));
+                }
+                if p.has("zmin") || p.has("zmax") || p.has("phimax") {
+                    self.b.ignore("partial spheres (rendered whole)");
+                }
+                if s.reverse && s.area.is_some() {
+                    self.b.ignore("ReverseOrientation on sphere emitters (they emit outwards)");
+                }
+                self.b.add_sphere(to_world, radius, material);
+            }
+        }
+        self.b.count(&format!("{} shapes", s.kind), 1);
+        for u in p.unused() {
+            self.b.ignore(format!("Shape \"{}\" parameter {u}", s.kind));
+        }
+        Ok(())
+    }
+}
+
+/// pbrt's LookAt (camera-from-world): x = up × dir, y = dir × x, z = dir.
+fn look_at(v: &[f64]) -> Option<DMat4> {
+    let (eye, target, up) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]), DVec3::new(v[6], v[7], v[8]));
+    let dir = (target - eye).try_normalize()?;
+    let right = up.try_normalize()?.cross(dir).try_normalize()?;
+    let new_up = dir.cross(right);
+    let world_from_camera = DMat4::from_cols(right.extend(0.0), new_up.extend(0.0), dir.extend(0.0), eye.extend(1.0));
+    Some(world_from_camera.inverse())
+}
+
+/// A float RGB image for an environment: PFM (ours) or EXR (the image crate), top row first.
+fn load_float_image(path: &Path, by: &str) -> Result<(u32, u32, Vec<[f32; 3]>), SceneError> {
+    let bytes = read_bytes(path, by)?;
+    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+    let bad = |m: String| SceneError::new(path, format!("{m} (referenced by {by})"));
+    match ext.as_str() {
+        "pfm" => crate::scene::pfm::decode(&bytes).map(|p| (p.width, p.height, p.texels)).map_err(bad),
+        "exr" | "hdr" => {
+            let img = crate::scene::catch_quietly(|| image::load_from_memory(&bytes))
+                .map_err(|e| bad(format!("corrupt image (the decoder failed: {e})")))?
+                .map_err(|e| bad(format!("cannot decode image: {e}")))?
+                .to_rgb32f();
+            Ok((img.width(), img.height(), img.pixels().map(|p| p.0).collect()))
+        }
+        _ => Err(bad(format!("unsupported environment map format '.{ext}' (expected .pfm or .exr)"))),
+    }
+}
