@@ -199,6 +199,10 @@ pub struct ReferenceImage {
 
 /// Reads an EXR (any writer) and, where present, the attributes `write_exr` records.
 pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
+    // A render state (`mislab merge`'s merged state, or a whole render's) is a reference too.
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("state")) {
+        return crate::state::RenderState::read(path).map(|s| s.reference_image());
+    }
     let img = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.into_rgb32f();
     let (width, height) = img.dimensions();
     let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();

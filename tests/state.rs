@@ -161,6 +161,10 @@ fn four_parts_merged_in_shuffled_order_match_the_single_render() {
     // The merged EXR is a reference: its header says spp.
     let r = mislab::reference::read_exr(&d.join("m1.exr")).unwrap();
     assert_eq!(r.attributes.get("spp").map(String::as_str), Some("60"));
+    // `mislab bench --ref` reads the merged state as a reference too.
+    let r = mislab::reference::read_exr(&d.join("m1.state")).unwrap();
+    assert_eq!(r.pixels, m1.accum.iter().map(|a| a.mean).collect::<Vec<_>>());
+    assert_eq!(r.attributes.get("spp").map(String::as_str), Some("60"));
     // Status of the directory: complete; then with a part gone, incomplete and naming it.
     let (code, t) = run_code(bin().args(["merge", "--status"]).arg(&d));
     assert_eq!(code, 0, "{t}");

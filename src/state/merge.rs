@@ -176,7 +176,7 @@ pub fn merge(parts: &[Part]) -> RenderState {
 /// The header attributes of a merged EXR: those of a `mislab reference` EXR, plus the scene hash and parts.
 pub fn exr_attributes(h: &StateHeader, parts: usize) -> Vec<(String, String)> {
     vec![
-        ("spp".into(), h.spp_total.to_string()),
+        ("spp".into(), h.done().to_string()),
         ("renderSeconds".into(), format!("{:.3}", h.seconds)),
         ("nonfiniteSamples".into(), h.nonfinite_total.to_string()),
         ("scene".into(), h.scene.clone()),

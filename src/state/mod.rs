@@ -191,6 +191,21 @@ impl RenderState {
         Film::from_accum(s.width, s.height, &self.accum, self.header.nonfinite_total)
     }
 
+    /// The mean image with a reference EXR's attributes (`mislab bench --ref` reads states through this).
+    pub fn reference_image(&self) -> crate::reference::ReferenceImage {
+        let s = &self.header.settings;
+        let attributes = merge::exr_attributes(&self.header, 0)
+            .into_iter()
+            .chain([("stateSamples".to_string(), format!("{}..{}", self.header.range.0, self.header.next))])
+            .collect();
+        crate::reference::ReferenceImage {
+            width: s.width,
+            height: s.height,
+            pixels: self.accum.iter().map(|a| a.mean).collect(),
+            attributes,
+        }
+    }
+
     /// The file's bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
         let json = serde_json::to_vec_pretty(&self.header).expect("a header always serialises");
