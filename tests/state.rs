@@ -344,3 +344,25 @@ fn chan_merge_equals_the_statistics_of_all_samples() {
     assert_eq!(ranges, vec![(0, 10), (10, 20), (20, 30)]);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn reference_parts_merge_to_the_whole_reference() {
+    let d = tmp("ref");
+    let args = ["reference", "veach-mis", "--width", "48", "--height", "32", "--spp", "16"];
+    run_ok(bin().args(args).arg("-o").arg(d.join("whole.exr")).arg("--state").arg(d.join("whole.state")));
+    for k in 0..3 {
+        run_ok(bin().args(args).arg("--part").arg(format!("{k}/3")).arg("-o").arg(d.join(format!("r{k}.exr"))));
+    }
+    let part = |k: u32| d.join(format!("r{k}.state"));
+    run_ok(bin().arg("merge").args([part(1), part(2), part(0)]).arg("-o").arg(d.join("merged.exr")));
+    let whole = RenderState::read(&d.join("whole.state")).unwrap();
+    let merged = mislab::reference::read_exr(&d.join("merged.exr")).unwrap();
+    assert_eq!(merged.attributes.get("spp").map(String::as_str), Some("16"));
+    for (a, b) in whole.accum.iter().zip(&merged.pixels) {
+        for c in 0..3 {
+            let (x, y) = (a.mean[c] as f64, b[c] as f64);
+            assert!((x - y).abs() <= 1e-5 * x.abs().max(y.abs()), "{x} vs {y}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
