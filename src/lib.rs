@@ -29,6 +29,7 @@ pub mod samplers;
 pub mod scene;
 pub mod settings;
 pub mod shaders;
+pub mod state;
 pub mod stress;
 pub mod suite_inputs;
 pub mod viewer;

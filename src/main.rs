@@ -36,6 +36,8 @@ enum Command {
     Render(RenderArgs),
     /// Render a high-quality reference (MIS, Sobol) to EXR; the header records spp and settings.
     Reference(mislab::reference::ReferenceArgs),
+    /// Combine the state files of `render --part K/N` runs into one image and state; --status DIR reports progress.
+    Merge(mislab::state::merge::MergeArgs),
     /// Run time against error: configurations × spp ladder × seeds, CSV/JSON and plots.
     Bench(mislab::bench::BenchArgs),
     /// Open the interactive viewer: the image converges while a panel switches estimators live.
@@ -75,6 +77,9 @@ struct RenderArgs {
     /// Estimator settings: the same names as the viewer panel and benchmark files.
     #[command(flatten)]
     settings: Settings,
+    /// State files, checkpoints, resume and parts (src/state).
+    #[command(flatten)]
+    state: mislab::state::session::StateArgs,
 }
 
 impl Default for RenderArgs {
@@ -111,6 +116,7 @@ fn main() -> ExitCode {
         Command::Info { scene } => info(scene),
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
         Command::Reference(args) => mislab::reference::run(&args).map(|_| 0).map_err(bad),
+        Command::Merge(args) => mislab::state::merge::run(&args).map_err(bad),
         Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
         Command::Stress { filter } => stress(filter.as_deref()),
         Command::Figure(args) => mislab::figure::run(&args).map(|_| 0).map_err(bad),
@@ -183,6 +189,8 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         (None, Some(t)) => return Err(bad(format!("--time {t} must be a positive number of seconds"))),
         (None, None) => Budget::Samples(64),
     };
+    // State flags and the state to resume first: a bad state file fails before any scene or device work.
+    let mut session = mislab::state::session::Session::open(&args.state, args.spp, &args.output).map_err(bad)?;
     let t_start = Instant::now();
     // Catch Ctrl-C from the start: during start-up it stops before rendering, afterwards it writes
     // what has accumulated.
@@ -223,10 +231,14 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     if let Some(w) = unreachable_light_warning(&data, &settings) {
         eprintln!("warning: {w}");
     }
+    let scene_hash = mislab::state::scene_hash(&data, &scene.camera);
     let gpu_scene = GpuScene::upload(&ctx, data).map_err(|e| bad(format!("{}: {e}", args.scene.scene)))?;
     let mut renderer = Renderer::new(&ctx, &gpu_scene, scene.camera.clone(), settings.clone()).map_err(bad)?;
     if let Budget::Samples(n) = budget {
         renderer.set_sampler_spp(n);
+    }
+    if let (Some(s), Budget::Samples(n)) = (session.as_mut(), budget) {
+        s.start(&mut renderer, &args.scene.scene, scene_hash, &settings, n, n).map_err(bad)?;
     }
     ctx.wait().map_err(|e| bad(e.to_string()))?;
     let t_ready = Instant::now();
@@ -250,15 +262,23 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let pixels = (settings.width * settings.height) as f64;
-    let stats = progressive::run(&ctx, &mut renderer, budget, &interrupt, |spp, secs| {
+    let progress = |spp: u32, secs: f64| {
         match budget {
             Budget::Samples(_) => bar.set_position(spp as u64),
             Budget::Time(_) => bar.set_position((secs * 1000.0) as u64),
         }
         bar.set_message(format!("{spp} spp, {:.2} M samples/s", spp as f64 * pixels / secs.max(1e-9) / 1e6));
-    })
+    };
+    let stats = match &session {
+        Some(s) => s.run(&ctx, &mut renderer, &interrupt, progress),
+        None => progressive::run(&ctx, &mut renderer, budget, &interrupt, progress),
+    }
     .map_err(|e| bad(e.to_string()))?;
     bar.finish_and_clear();
+    if let Some(s) = &session {
+        s.save(&ctx, &renderer, stats.seconds).map_err(bad)?;
+        eprintln!("wrote state {} (samples {}..{})", s.path().display(), s.range().0, renderer.samples());
+    }
     let film = renderer.film(&ctx).map_err(|e| bad(e.to_string()))?;
     film.save(&args.output, settings.exposure, args.tonemap).map_err(bad)?;
     eprintln!(

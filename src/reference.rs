@@ -56,6 +56,13 @@ pub struct ReferenceArgs {
     /// Seed.
     #[arg(long, default_value_t = REFERENCE_SEED)]
     pub seed: u32,
+    /// Render only the K-th (from 0) of N sample ranges of --spp into a state file (--state, default: the
+    /// output's name with .state); `mislab merge` makes the reference of the parts (docs/cluster.md).
+    #[arg(long, value_name = "K/N", value_parser = crate::state::session::parse_part, requires = "spp")]
+    pub part: Option<(u32, u32)>,
+    /// Also write the render state (for `mislab merge`) to this file.
+    #[arg(long, value_name = "FILE", requires = "spp")]
+    pub state: Option<PathBuf>,
 }
 
 /// The reference estimator for a film and mode: MIS (multi-sample, power heuristic, one light and one BSDF
@@ -82,11 +89,26 @@ pub fn render_reference(
     budget: Budget,
     dispatch_spp: u32,
 ) -> Result<(Film, RenderStats), String> {
-    let gpu_scene = GpuScene::upload(ctx, SceneData::build(scene)).map_err(|e| e.to_string())?;
+    render_reference_from(ctx, SceneData::build(scene), scene, settings, budget, dispatch_spp, 0)
+}
+
+/// `render_reference` of the sample indices from `first` on (`--part`: `state::session::part_range`), with the
+/// scene's data already built.
+pub fn render_reference_from(
+    ctx: &GpuContext,
+    data: SceneData,
+    scene: &Scene,
+    settings: &Settings,
+    budget: Budget,
+    dispatch_spp: u32,
+    first: u32,
+) -> Result<(Film, RenderStats), String> {
+    let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| e.to_string())?;
     let mut r = Renderer::new(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?;
     let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { r.max_dispatch_spp() };
+    let pixels = settings.width as usize * settings.height as usize;
     for _attempt in 0..8 {
-        r.reset();
+        r.restore(&vec![crate::gpu_types::GpuAccum::default(); pixels], first, 0, 0)?;
         r.set_dispatch_spp(Some(dispatch));
         let mut timer = GpuTimer::new(ctx, 64);
         let start = Instant::now();
@@ -95,9 +117,9 @@ pub fn render_reference(
         let mut chunk = dispatch;
         loop {
             let n = match budget {
-                Budget::Samples(total) => chunk.min(total - r.samples()),
+                Budget::Samples(total) => chunk.min(total - (r.samples() - first)),
                 Budget::Time(t) => {
-                    if r.samples() > 0 && start.elapsed() >= t {
+                    if r.samples() > first && start.elapsed() >= t {
                         0
                     } else {
                         chunk
@@ -114,15 +136,15 @@ pub fn render_reference(
                 chunk = (chunk * 2).min(1 << 16);
             }
             if let Budget::Time(limit) = budget {
-                let per = seconds / r.samples() as f64;
+                let per = seconds / (r.samples() - first) as f64;
                 let left = limit.saturating_sub(start.elapsed()).as_secs_f64();
                 chunk = chunk.min(((left / per.max(1e-9)).ceil() as u32).max(1));
             }
         }
         let film = r.film(ctx).map_err(|e| e.to_string())?;
-        if film.is_complete(r.samples()) {
-            let stats =
-                RenderStats { spp: r.samples(), seconds, rays, nonfinite: r.nonfinite_total(), interrupted: false };
+        if film.is_complete(r.samples() - first) {
+            let spp = r.samples() - first;
+            let stats = RenderStats { spp, seconds, rays, nonfinite: r.nonfinite_total(), interrupted: false };
             return Ok((film, stats));
         }
         if dispatch == 1 {
@@ -199,6 +221,10 @@ pub struct ReferenceImage {
 
 /// Reads an EXR (any writer) and, where present, the attributes `write_exr` records.
 pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
+    // A render state (`mislab merge`'s merged state, or a whole render's) is a reference too.
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("state")) {
+        return crate::state::RenderState::read(path).map(|s| s.reference_image());
+    }
     let img = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.into_rgb32f();
     let (width, height) = img.dimensions();
     let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
@@ -244,8 +270,36 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let scene = args.scene.load()?;
     let t = Instant::now();
-    let (film, stats) = render_reference(&ctx, &scene, &settings, budget, 0)?;
+    let data = SceneData::build(&scene);
+    let scene_hash = crate::state::scene_hash(&data, &scene.camera);
+    let total = args.spp.unwrap_or(0);
+    let range = args.part.map_or((0, total), |(k, n)| crate::state::session::part_range(k, n, total));
+    let budget = if args.part.is_some() { Budget::Samples(range.1 - range.0) } else { budget };
+    if range.0 == range.1 {
+        return Err(format!("--part of --spp {total} holds no samples (use at most {total} parts)"));
+    }
+    let (film, stats) = render_reference_from(&ctx, data, &scene, &settings, budget, 0, range.0)?;
     write_exr(&args.output, &film, &header_attributes(&args.scene, &settings, &stats))?;
+    if args.part.is_some() || args.state.is_some() {
+        let header = crate::state::StateHeader {
+            scene: args.scene.scene.clone(),
+            scene_hash,
+            settings: settings.clone(),
+            seed: settings.seed,
+            spp_total: total,
+            sampler_spp: crate::samplers::DEFAULT_SAMPLER_SPP,
+            part: args.part,
+            range,
+            next: range.1,
+            nonfinite_total: stats.nonfinite,
+            rays_total: stats.rays,
+            seconds: stats.seconds,
+            mislab_version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        let path = args.state.clone().unwrap_or_else(|| args.output.with_extension("state"));
+        crate::state::RenderState::from_film(header, &film).write(&path)?;
+        eprintln!("wrote state {} (samples {}..{})", path.display(), range.0, range.1);
+    }
     let pixels = (settings.width * settings.height) as f64;
     eprintln!(
         "{} spp in {:.2} s ({:.2} s with compilation): {:.2} M samples/s, {} NaN/Inf samples; wrote {}",

@@ -364,6 +364,27 @@ impl Renderer {
         self.rays_total = 0;
     }
 
+    /// Continues from saved accumulators (a render state file, `state::RenderState`): the film holds `accum`
+    /// exactly and the next pass starts at sample index `samples`.
+    pub fn restore(
+        &mut self,
+        accum: &[GpuAccum],
+        samples: u32,
+        nonfinite_total: u64,
+        rays_total: u64,
+    ) -> Result<(), String> {
+        let pixels = self.settings.width as usize * self.settings.height as usize;
+        if accum.len() != pixels {
+            return Err(format!("a state of {} pixels cannot continue a {pixels}-pixel film", accum.len()));
+        }
+        self.reset();
+        self.queue.write_buffer(&self.accum, 0, bytemuck::cast_slice(accum));
+        self.samples = samples;
+        self.nonfinite_total = nonfinite_total;
+        self.rays_total = rays_total;
+        Ok(())
+    }
+
     /// Changes settings (film size excluded), resets and builds the pipeline they need.
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), String> {
         self.configure(settings)?;

@@ -1,0 +1,229 @@
+//! The render command's state flags (`--state`, `--checkpoint-every`, `--resume`, `--part`): which sample
+//! indices this run renders, restoring a saved state into the renderer, and writing checkpoints while it renders.
+
+use super::{RenderState, StateHeader};
+use crate::gpu::GpuContext;
+use crate::gpu_types::GpuAccum;
+use crate::progressive::{RenderStats, TARGET_SUBMIT_SECONDS};
+use crate::render::Renderer;
+use crate::settings::Settings;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// `mislab render` flags for state files, checkpoints and parts.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct StateArgs {
+    /// Write the render state (raw per-pixel accumulators + header) to this file at the end (and at every
+    /// checkpoint); default with --part or --checkpoint-every: the output's name with extension .state.
+    #[arg(long, value_name = "FILE")]
+    pub state: Option<PathBuf>,
+    /// Write the state atomically every SECONDS (fractions allowed) while rendering.
+    #[arg(long, value_name = "SECONDS")]
+    pub checkpoint_every: Option<f64>,
+    /// Continue the render saved in STATE (same scene, settings and --spp), checkpointing on into it unless
+    /// --state names another file. The result equals the uninterrupted render bit for bit.
+    #[arg(long, value_name = "STATE")]
+    pub resume: Option<PathBuf>,
+    /// Render only the K-th (from 0) of N disjoint ranges of the --spp sample indices; `mislab merge` combines
+    /// the N state files.
+    #[arg(long, value_name = "K/N", value_parser = parse_part)]
+    pub part: Option<(u32, u32)>,
+}
+
+/// Parses `K/N` with 0 ≤ K < N.
+pub fn parse_part(s: &str) -> Result<(u32, u32), String> {
+    let (k, n) = s.split_once('/').ok_or_else(|| format!("--part {s}: expected K/N, e.g. 0/4"))?;
+    let k: u32 = k.trim().parse().map_err(|_| format!("--part {s}: K must be a whole number"))?;
+    let n: u32 = n.trim().parse().map_err(|_| format!("--part {s}: N must be a whole number"))?;
+    if n == 0 || k >= n {
+        return Err(format!("--part {s}: needs 0 <= K < N (parts are numbered from 0, like Slurm array tasks)"));
+    }
+    Ok((k, n))
+}
+
+/// The sample indices `[start, end)` of part `k` of `n` of a `total`-sample render (sizes differ by at most one).
+pub fn part_range(k: u32, n: u32, total: u32) -> (u32, u32) {
+    let at = |i: u32| (i as u64 * total as u64 / n as u64) as u32;
+    (at(k), at(k + 1))
+}
+
+impl StateArgs {
+    /// Whether any state flag was given.
+    pub fn active(&self) -> bool {
+        self.state.is_some() || self.checkpoint_every.is_some() || self.resume.is_some() || self.part.is_some()
+    }
+}
+
+/// One render run's state handling.
+pub struct Session {
+    path: PathBuf,
+    every: Option<Duration>,
+    part: Option<(u32, u32)>,
+    resumed: Option<RenderState>,
+    header: Option<StateHeader>,
+    seconds_before: f64,
+}
+
+impl Session {
+    /// Checks the flags and reads the state to resume (before any scene or device work, so a bad state file
+    /// fails fast). `spp` is the render's --spp, `output` its image.
+    pub fn open(args: &StateArgs, spp: Option<u32>, output: &Path) -> Result<Option<Session>, String> {
+        if !args.active() {
+            return Ok(None);
+        }
+        if spp.is_none() {
+            return Err("--state, --checkpoint-every, --resume and --part need --spp N (the sample range a state holds is fixed by it; --time is not reproducible)".into());
+        }
+        let every = match args.checkpoint_every {
+            None => None,
+            Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
+            Some(t) => return Err(format!("--checkpoint-every {t} must be a positive number of seconds")),
+        };
+        let resumed = args.resume.as_deref().map(RenderState::read).transpose()?;
+        let path = args.state.clone().or_else(|| args.resume.clone()).unwrap_or_else(|| output.with_extension("state"));
+        Ok(Some(Session { path, every, part: args.part, resumed, header: None, seconds_before: 0.0 }))
+    }
+
+    /// The state file this run writes.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Puts `renderer` at this run's first sample: the resumed state's accumulators and next index, or an empty
+    /// film at the start of the part. Refuses a resumed state of another scene or other settings, naming each
+    /// difference. Call after `set_sampler_spp` (which resets).
+    pub fn start(
+        &mut self,
+        renderer: &mut Renderer,
+        scene: &str,
+        scene_hash: String,
+        settings: &Settings,
+        spp_total: u32,
+        sampler_spp: u32,
+    ) -> Result<(), String> {
+        let range = match self.part {
+            Some((k, n)) => part_range(k, n, spp_total),
+            None => (0, spp_total),
+        };
+        if range.0 == range.1 {
+            let (k, n) = self.part.unwrap_or((0, 1));
+            return Err(format!(
+                "--part {k}/{n} of --spp {spp_total} holds no samples (use at most {spp_total} parts)"
+            ));
+        }
+        let header = StateHeader {
+            scene: scene.to_string(),
+            scene_hash,
+            settings: settings.clone(),
+            seed: settings.seed,
+            spp_total,
+            sampler_spp,
+            part: self.part,
+            range,
+            next: range.0,
+            nonfinite_total: 0,
+            rays_total: 0,
+            seconds: 0.0,
+            mislab_version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        match self.resumed.take() {
+            Some(state) => {
+                let name = self.resume_name();
+                if let Some(d) = state.header.differences(&header) {
+                    return Err(format!(
+                        "{name}: cannot resume: the state is of a different render (saved vs this command): {d}"
+                    ));
+                }
+                if state.header.part != header.part || state.header.range != header.range {
+                    return Err(format!(
+                        "{name}: cannot resume: the state holds part {:?} (samples {:?}), this command renders part {:?} (samples {:?})",
+                        state.header.part, state.header.range, header.part, header.range
+                    ));
+                }
+                renderer.restore(
+                    &state.accum,
+                    state.header.next,
+                    state.header.nonfinite_total,
+                    state.header.rays_total,
+                )?;
+                eprintln!(
+                    "resuming {name}: samples {}..{} of {}..{} done",
+                    state.header.range.0, state.header.next, range.0, range.1
+                );
+                self.seconds_before = state.header.seconds;
+                self.header = Some(StateHeader { next: state.header.next, ..header });
+            }
+            None => {
+                let pixels = (settings.width * settings.height) as usize;
+                renderer.restore(&vec![GpuAccum::default(); pixels], range.0, 0, 0)?;
+                self.header = Some(header);
+            }
+        }
+        Ok(())
+    }
+
+    fn resume_name(&self) -> String {
+        self.path.display().to_string()
+    }
+
+    /// Sample indices `[start, end)` of this run's file.
+    pub fn range(&self) -> (u32, u32) {
+        self.header.as_ref().map_or((0, 0), |h| h.range)
+    }
+
+    /// Writes the renderer's current state to the state file (atomically).
+    pub fn save(&self, ctx: &GpuContext, renderer: &Renderer, seconds: f64) -> Result<(), String> {
+        let header = self.header.as_ref().ok_or("Session::save before Session::start")?;
+        let film = renderer.film(ctx).map_err(|e| e.to_string())?;
+        let header = StateHeader {
+            next: renderer.samples(),
+            nonfinite_total: renderer.nonfinite_total(),
+            rays_total: renderer.rays_total(),
+            seconds: self.seconds_before + seconds,
+            ..header.clone()
+        };
+        RenderState::from_film(header, &film).write(&self.path)
+    }
+
+    /// Renders the rest of the range in submissions of about a second (shorter with a shorter checkpoint
+    /// interval), checkpointing when due, until done or `interrupt`. `progress(next_sample_index, seconds)`.
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        renderer: &mut Renderer,
+        interrupt: &AtomicBool,
+        mut progress: impl FnMut(u32, f64),
+    ) -> Result<RenderStats, String> {
+        let end = self.range().1;
+        let start = Instant::now();
+        let (first, rays_first) = (renderer.samples(), renderer.rays_total());
+        let mut last_checkpoint = Instant::now();
+        let target = self.every.map_or(TARGET_SUBMIT_SECONDS, |e| e.as_secs_f64().min(TARGET_SUBMIT_SECONDS));
+        let mut batch = 1u32;
+        let mut interrupted = false;
+        while renderer.samples() < end {
+            if interrupt.load(Ordering::SeqCst) {
+                interrupted = true;
+                break;
+            }
+            let n = batch.min(end - renderer.samples());
+            let t0 = Instant::now();
+            renderer.render(ctx, n)?;
+            let dt = t0.elapsed().as_secs_f64();
+            progress(renderer.samples(), start.elapsed().as_secs_f64());
+            if self.every.is_some_and(|e| last_checkpoint.elapsed() >= e) && renderer.samples() < end {
+                self.save(ctx, renderer, start.elapsed().as_secs_f64())?;
+                last_checkpoint = Instant::now();
+            }
+            batch = ((target / (dt / n as f64).max(1e-9)) as u32).clamp(1, 4096);
+        }
+        Ok(RenderStats {
+            spp: renderer.samples() - first,
+            seconds: start.elapsed().as_secs_f64(),
+            rays: renderer.rays_total() - rays_first,
+            nonfinite: renderer.nonfinite_total(),
+            interrupted,
+        })
+    }
+}
