@@ -16,7 +16,7 @@ struct BsdfParams {
     metallic: f32,
     alpha: f32,
     specular: f32,
-    kind: u32,               // MATERIAL_* (common.wgsl); the fields above are metallic-roughness's
+    bsdf_kind: u32,          // MATERIAL_* (common.wgsl); the fields above are metallic-roughness's
     eta: vec3<f32>,          // conductor: RGB η
     alpha_v: f32,            // conductor: GGX α along the bitangent (alpha: along the tangent)
     k: vec3<f32>,            // conductor: RGB k
@@ -93,7 +93,7 @@ fn bsdf_specular_probability(p: BsdfParams, wo: vec3<f32>) -> f32 {
 
 /// f_r(wo, wi) without the cosine. Zero below either hemisphere.
 fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    if (HAS_CONDUCTOR && p.kind == MATERIAL_CONDUCTOR) { return conductor_eval(p, wo, wi); }
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_eval(p, wo, wi); }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return vec3<f32>(0.0); }
     let h = normalize(wo + wi);
     let fw = schlick_weight(dot(wo, h));
@@ -111,7 +111,7 @@ fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 
 /// pdf (solid angle) of `bsdf_sample` producing wi: the mixture of cosine and visible-normal sampling.
 fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if (HAS_CONDUCTOR && p.kind == MATERIAL_CONDUCTOR) { return conductor_pdf(p, wo, wi); }
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_pdf(p, wo, wi); }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
     let ps = bsdf_specular_probability(p, wo);
     var pdf = (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
@@ -122,7 +122,7 @@ fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 /// Samples wi: picks a lobe with u_lobe, then cosine (diffuse) or a reflected visible normal (specular).
 /// pdf = 0 marks a failed sample (below the surface).
 fn bsdf_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
-    if (HAS_CONDUCTOR && p.kind == MATERIAL_CONDUCTOR) { return conductor_sample(p, wo, u); }
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_sample(p, wo, u); }
     var s: BsdfSample;
     s.pdf = 0.0;
     s.f = vec3<f32>(0.0);

@@ -115,7 +115,7 @@ struct Material {
     em_xform0: vec4<f32>,
     em_xform1: vec4<f32>,
     eta: vec3<f32>,         // conductor: RGB η (bsdf_conductor.wgsl)
-    kind: u32,              // MATERIAL_* tag
+    bsdf_kind: u32,         // MATERIAL_* tag
     k: vec3<f32>,           // conductor: RGB k
     alpha_v: f32,           // conductor: GGX α along the bitangent (alpha: along the tangent)
 }

@@ -90,7 +90,7 @@ impl Features {
     /// What `data` needs.
     pub fn of(data: &SceneData) -> Features {
         // The metallic-roughness materials (other kinds have their own constants).
-        let mr = data.materials.iter().filter(|m| m.kind == MATERIAL_METALLIC_ROUGHNESS);
+        let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
         let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
         let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
             (false, _) => EnvKind::None,
@@ -109,7 +109,7 @@ impl Features {
             textures: !data.tex_info.is_empty(),
             specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
-            conductor: data.materials.iter().any(|m| m.kind == MATERIAL_CONDUCTOR),
+            conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
             many_lights: data.lights.len() > 1,
             flat: flat_counts(data),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {

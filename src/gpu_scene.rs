@@ -184,7 +184,7 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         base_color: m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0)),
         metallic: finite(m.metallic, 0.0).clamp(0.0, 1.0),
         emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
-        alpha: if kind.kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
+        alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
         specular: finite(m.specular, 1.0).clamp(0.0, 1.0),
         base_tex: bt,
         mr_tex: mt,
@@ -205,9 +205,9 @@ fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
     let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
     let alpha = |a: f32| finite(a, 1.0).clamp(ALPHA_MIN, 1.0);
     match &m.kind {
-        MaterialKind::MetallicRoughness => GpuMaterial { kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
+        MaterialKind::MetallicRoughness => GpuMaterial { bsdf_kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
         MaterialKind::Conductor { eta, k, alpha_u, alpha_v } => GpuMaterial {
-            kind: MATERIAL_CONDUCTOR,
+            bsdf_kind: MATERIAL_CONDUCTOR,
             eta: eta.to_array().map(|c| finite(c, 1.0).max(1e-3)),
             k: k.to_array().map(|c| finite(c, 0.0).max(0.0)),
             alpha: alpha(*alpha_u),

@@ -62,7 +62,7 @@ fn shared_structs_match() {
             em_xform0,
             em_xform1,
             eta,
-            kind,
+            bsdf_kind,
             k,
             alpha_v
         ]
