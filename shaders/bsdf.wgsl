@@ -7,6 +7,8 @@
 //   F_d = f0 + (f90 − f0)(1 − |wo·h|)⁵ with f0 = 0.04·specular, f90 = specular;  F_m = base + (1 − base)(1 − |wo·h|)⁵
 //   D: GGX (Trowbridge–Reitz); G2: height-correlated Smith.
 // Lambert is {m = 0, specular = 0}; a GGX conductor with Fresnel 1 is {m = 1, base = 1}.
+// bsdf_eval / bsdf_pdf / bsdf_sample are also the dispatch over material kinds: a kind the scene does not use
+// is compiled out by its HAS_* constant, so metallic-roughness scenes run exactly the code they ran before.
 
 /// What the BSDF needs at one shading point (textures already applied).
 struct BsdfParams {
@@ -14,6 +16,10 @@ struct BsdfParams {
     metallic: f32,
     alpha: f32,
     specular: f32,
+    bsdf_kind: u32,          // MATERIAL_* (common.wgsl); the fields above are metallic-roughness's
+    eta: vec3<f32>,          // conductor: RGB η
+    alpha_v: f32,            // conductor: GGX α along the bitangent (alpha: along the tangent)
+    k: vec3<f32>,            // conductor: RGB k
 }
 
 /// A sampled direction: wi (local), the pdf of the sampling technique (solid angle), and f (no cosine).
@@ -87,6 +93,7 @@ fn bsdf_specular_probability(p: BsdfParams, wo: vec3<f32>) -> f32 {
 
 /// f_r(wo, wi) without the cosine. Zero below either hemisphere.
 fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_eval(p, wo, wi); }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return vec3<f32>(0.0); }
     let h = normalize(wo + wi);
     let fw = schlick_weight(dot(wo, h));
@@ -104,6 +111,7 @@ fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 
 /// pdf (solid angle) of `bsdf_sample` producing wi: the mixture of cosine and visible-normal sampling.
 fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_pdf(p, wo, wi); }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
     let ps = bsdf_specular_probability(p, wo);
     var pdf = (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
@@ -114,6 +122,7 @@ fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 /// Samples wi: picks a lobe with u_lobe, then cosine (diffuse) or a reflected visible normal (specular).
 /// pdf = 0 marks a failed sample (below the surface).
 fn bsdf_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_sample(p, wo, u); }
     var s: BsdfSample;
     s.pdf = 0.0;
     s.f = vec3<f32>(0.0);

@@ -116,7 +116,14 @@ struct Material {
     mr_xform1: vec4<f32>,
     em_xform0: vec4<f32>,
     em_xform1: vec4<f32>,
+    eta: vec3<f32>,         // conductor: RGB η (bsdf_conductor.wgsl)
+    bsdf_kind: u32,         // MATERIAL_* tag
+    k: vec3<f32>,           // conductor: RGB k
+    alpha_v: f32,           // conductor: GGX α along the bitangent (alpha: along the tangent)
 }
+
+const MATERIAL_METALLIC_ROUGHNESS: u32 = 0u;
+const MATERIAL_CONDUCTOR: u32 = 1u;
 
 /// One entry of the light table. For area lights `prim` indexes triangles/spheres/quads; for
 /// punctual lights `position`/`direction` are used. `pmf` is this light's selection probability under
@@ -263,6 +270,8 @@ override ENV_KIND: u32 = 3u;
 override HAS_TEXTURES: bool = true;
 /// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
 override HAS_SPECULAR: bool = true;
+/// Any MaterialKind::Conductor (bsdf_conductor.wgsl).
+override HAS_CONDUCTOR: bool = true;
 /// Whether any material has a diffuse lobe.
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.

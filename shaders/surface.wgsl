@@ -113,7 +113,7 @@ fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) ->
 
 /// The material's BSDF parameters at `uv`.
 fn material_bsdf(m: Material, uv: vec2<f32>) -> BsdfParams {
-    var p = BsdfParams(m.base_color, m.metallic, m.alpha, m.specular);
+    var p = BsdfParams(m.base_color, m.metallic, m.alpha, m.specular, m.bsdf_kind, m.eta, m.alpha_v, m.k);
     if (HAS_TEXTURES && m.base_tex != INVALID) {
         p.base_color *= texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
     }

@@ -102,6 +102,10 @@ const MATERIAL_MEMBERS: &[&str] = &[
     "vec4<f32>",
     "vec4<f32>",
     "vec4<f32>",
+    "vec3<f32>",
+    "u32",
+    "vec3<f32>",
+    "f32",
 ];
 const LIGHT_MEMBERS: &[&str] = &[
     "vec3<f32>",

@@ -43,6 +43,8 @@ pub struct Features {
     pub specular: bool,
     /// Any material with a diffuse lobe.
     pub diffuse: bool,
+    /// Any `MaterialKind::Conductor` (shaders/bsdf_conductor.wgsl).
+    pub conductor: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
     /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
@@ -78,6 +80,7 @@ impl Features {
             textures: true,
             specular: true,
             diffuse: true,
+            conductor: true,
             many_lights: true,
             flat: None,
             baked: 0,
@@ -86,6 +89,8 @@ impl Features {
 
     /// What `data` needs.
     pub fn of(data: &SceneData) -> Features {
+        // The metallic-roughness materials (other kinds have their own constants).
+        let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
         let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
         let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
             (false, _) => EnvKind::None,
@@ -102,8 +107,9 @@ impl Features {
             delta_lights: kinds(LIGHT_POINT) || kinds(LIGHT_SPOT) || kinds(LIGHT_DIRECTIONAL),
             env,
             textures: !data.tex_info.is_empty(),
-            specular: data.materials.iter().any(|m| m.metallic > 0.0 || m.specular > 0.0),
-            diffuse: data.materials.iter().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
+            specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
+            diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
+            conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
             many_lights: data.lights.len() > 1,
             flat: flat_counts(data),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {
@@ -130,6 +136,7 @@ impl Features {
             ("HAS_TEXTURES", b(self.textures)),
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
+            ("HAS_CONDUCTOR", b(self.conductor)),
             ("MANY_LIGHTS", b(self.many_lights)),
             ("FLAT_SCENE", b(self.flat.is_some())),
         ]
@@ -153,6 +160,7 @@ impl Features {
         on("textures", self.textures);
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
+        on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);
         on("light selection", self.many_lights);
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));

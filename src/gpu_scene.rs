@@ -187,11 +187,12 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     let (m0, m1, mt) = xform(&m.metallic_roughness_texture);
     let (e0, e1, et) = xform(&m.emissive_texture);
     let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
+    let kind = material_kind(m);
     GpuMaterial {
         base_color: m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0)),
         metallic: finite(m.metallic, 0.0).clamp(0.0, 1.0),
         emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
-        alpha: m.alpha(),
+        alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
         specular: finite(m.specular, 1.0).clamp(0.0, 1.0),
         base_tex: bt,
         mr_tex: mt,
@@ -202,6 +203,25 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         mr_xform1: m1,
         em_xform0: e0,
         em_xform1: e1,
+        ..kind
+    }
+}
+
+/// The kind tag and the kind's own parameters (sanitised: finite, η > 0, k ≥ 0, α ≥ ALPHA_MIN).
+fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
+    use crate::scene::{MaterialKind, ALPHA_MIN};
+    let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
+    let alpha = |a: f32| finite(a, 1.0).clamp(ALPHA_MIN, 1.0);
+    match &m.kind {
+        MaterialKind::MetallicRoughness => GpuMaterial { bsdf_kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
+        MaterialKind::Conductor { eta, k, alpha_u, alpha_v } => GpuMaterial {
+            bsdf_kind: MATERIAL_CONDUCTOR,
+            eta: eta.to_array().map(|c| finite(c, 1.0).max(1e-3)),
+            k: k.to_array().map(|c| finite(c, 0.0).max(0.0)),
+            alpha: alpha(*alpha_u),
+            alpha_v: alpha(*alpha_v),
+            ..Default::default()
+        },
     }
 }
 

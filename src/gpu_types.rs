@@ -91,7 +91,17 @@ pub struct GpuMaterial {
     pub mr_xform1: [f32; 4],
     pub em_xform0: [f32; 4],
     pub em_xform1: [f32; 4],
+    /// Conductor: RGB η; `bsdf_kind` is a `MATERIAL_*` tag.
+    pub eta: [f32; 3],
+    pub bsdf_kind: u32,
+    /// Conductor: RGB k; `alpha_v` the second GGX α (`alpha` is the first).
+    pub k: [f32; 3],
+    pub alpha_v: f32,
 }
+
+/// Material kinds (`GpuMaterial::bsdf_kind`), as `scene::MaterialKind`.
+pub const MATERIAL_METALLIC_ROUGHNESS: u32 = 0;
+pub const MATERIAL_CONDUCTOR: u32 = 1;
 
 /// One entry of the light table (WGSL `Light`).
 #[repr(C)]

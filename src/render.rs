@@ -26,6 +26,7 @@ pub const RENDER_FILES: &[&str] = &[
     "bvh.wgsl",
     "baked_geometry.wgsl",
     "scene_data.wgsl",
+    "bsdf_conductor.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
     "lights.wgsl",

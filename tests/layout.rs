@@ -60,7 +60,11 @@ fn shared_structs_match() {
             mr_xform0,
             mr_xform1,
             em_xform0,
-            em_xform1
+            em_xform1,
+            eta,
+            bsdf_kind,
+            k,
+            alpha_v
         ]
     );
     check!(

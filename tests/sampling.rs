@@ -23,7 +23,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 59;
+const FAMILY: usize = 63;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -87,7 +87,10 @@ fn probe_u(i: u32) -> vec4<f32> {
     return h;
 }
 
-fn probe_bsdf() -> BsdfParams { return BsdfParams(probe_job.b.xyz, probe_job.b.w, probe_job.a.x, probe_job.a.y); }
+// a = (α, specular, kind, α_v), b = (base colour, metallic); η, k do not change where samples go.
+fn probe_bsdf() -> BsdfParams {
+    return BsdfParams(probe_job.b.xyz, probe_job.b.w, probe_job.a.x, probe_job.a.y, u32(probe_job.a.z), vec3<f32>(1.5), probe_job.a.w, vec3<f32>(3.0));
+}
 
 /// The light's geometric normal at y (either orientation), as surface_at computes it.
 fn probe_light_normal(i: u32, y: vec3<f32>) -> vec3<f32> {
@@ -1222,6 +1225,34 @@ fn chi2_bsdf() {
     run_all("bsdf", &bsdf_cases());
 }
 
+/// The anisotropic GGX conductor's visible-normal sampling (shaders/bsdf_conductor.wgsl), binned over the sphere of
+/// wi, with wo off both frame axes so that the stretch in x and y both matter.
+fn conductor_cases() -> Vec<Case> {
+    let mut v = Vec::new();
+    for (au, av, inc) in [(0.5f32, 0.2f32, 30.0f64), (0.3, 0.8, 75.0), (0.25, 0.5, 45.0), (0.6, 0.6, 60.0)] {
+        let t = deg(inc);
+        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let mut c = bsdf_case(
+            "anisotropic GGX conductor (VNDF)",
+            format!("α_u = {au}, α_v = {av}, θo = {inc}°"),
+            wo,
+            [1.0; 3],
+            0.0,
+            au,
+            0.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [au, 0.0, 1.0, av];
+        v.push(c);
+    }
+    v
+}
+
+#[test]
+fn chi2_conductor() {
+    run_all("conductor", &conductor_cases());
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Environment
 
@@ -1411,7 +1442,13 @@ fn chi2_light_tree_selection() {
 /// The number of chi-square tests equals the family size used for the Šidák correction.
 #[test]
 fn family_size() {
-    let n = warp_cases().len() + light_cases().len() + bsdf_cases().len() + env_cases().len() + 2 + TREE_POINTS.len();
+    let n = warp_cases().len()
+        + light_cases().len()
+        + bsdf_cases().len()
+        + conductor_cases().len()
+        + env_cases().len()
+        + 2
+        + TREE_POINTS.len();
     assert_eq!(n, FAMILY, "update FAMILY to the number of chi-square tests");
 }
 

@@ -140,12 +140,50 @@ impl TextureRef {
     }
 }
 
-/// glTF metallic-roughness material with `KHR_materials_specular` (specularFactor) and emission.
+/// Which BSDF a material uses (docs/materials.md). `MetallicRoughness` is the glTF model and reads the
+/// `base_color` / `metallic` / `roughness` / `specular` fields and textures; every other kind carries its own
+/// parameters and ignores those fields (emission and the emissive texture apply to every kind).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub enum MaterialKind {
+    /// glTF 2.0 metallic-roughness with KHR_materials_specular (also Lambert and the Fresnel-1 GGX conductor).
+    #[default]
+    MetallicRoughness,
+    /// A conductor with the complex Fresnel term of RGB `eta` + i·`k`, and an anisotropic GGX
+    /// (Trowbridge–Reitz) microsurface of α `alpha_u` along the shading frame's tangent and `alpha_v` along its
+    /// bitangent (α = 0 is clamped to `ALPHA_MIN`: a near-mirror, not yet an exact delta lobe).
+    Conductor {
+        /// Real part of the index of refraction, per RGB channel.
+        eta: Vec3,
+        /// Imaginary part (absorption), per RGB channel.
+        k: Vec3,
+        /// GGX α along the tangent.
+        alpha_u: f32,
+        /// GGX α along the bitangent.
+        alpha_v: f32,
+    },
+}
+
+impl MaterialKind {
+    /// The conductor whose normal-incidence Fresnel reflectance is `r` (per channel, in [0, 1)), as pbrt-v4's
+    /// `conductor "reflectance"`: η = 1, k = 2√r / √(1 − r), which gives F(0) = k²/(4 + k²) = r.
+    pub fn conductor_from_reflectance(r: Vec3, alpha_u: f32, alpha_v: f32) -> MaterialKind {
+        let k = |r: f32| {
+            let r = r.clamp(0.0, 0.9999);
+            2.0 * r.sqrt() / (1.0 - r).sqrt()
+        };
+        MaterialKind::Conductor { eta: Vec3::ONE, k: Vec3::new(k(r.x), k(r.y), k(r.z)), alpha_u, alpha_v }
+    }
+}
+
+/// A material: its BSDF (`kind`), and the glTF metallic-roughness fields `kind = MetallicRoughness` reads, with
+/// `KHR_materials_specular` (specularFactor) and emission.
 /// Lambert: metallic 0, specular 0. GGX conductor with Fresnel 1: metallic 1, base colour = reflectance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// Name, for messages.
     pub name: String,
+    /// The BSDF; the fields below up to `specular` are those of `MaterialKind::MetallicRoughness`.
+    pub kind: MaterialKind,
     /// Linear base colour (albedo for the diffuse lobe, F0 for metals).
     pub base_color: Vec3,
     /// Metalness in [0, 1].
@@ -168,6 +206,7 @@ impl Default for Material {
     fn default() -> Self {
         Material {
             name: "default".into(),
+            kind: MaterialKind::MetallicRoughness,
             base_color: Vec3::splat(0.8),
             metallic: 0.0,
             roughness: 1.0,

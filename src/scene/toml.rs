@@ -3,8 +3,8 @@
 
 use super::envmap::load_envmap;
 use super::{
-    builtin::vertex_normals, Camera, Environment, LoadOptions, Material, Mesh, PunctualLight, Quad, Scene, SceneError,
-    Sphere,
+    builtin::vertex_normals, Camera, Environment, LoadOptions, Material, MaterialKind, Mesh, PunctualLight, Quad,
+    Scene, SceneError, Sphere,
 };
 use ::toml::Spanned;
 use glam::{Mat3, Mat4, Quat, Vec3};
@@ -106,6 +106,10 @@ struct MaterialDef {
     roughness: Option<f32>,
     specular: Option<f32>,
     emission: Option<Splat<3>>,
+    eta: Option<Splat<3>>,
+    k: Option<Splat<3>>,
+    alpha_u: Option<f32>,
+    alpha_v: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -439,10 +443,14 @@ fn material(
         ("roughness", d.roughness.is_some()),
         ("specular", d.specular.is_some()),
         ("emission", d.emission.is_some()),
+        ("eta", d.eta.is_some()),
+        ("k", d.k.is_some()),
+        ("alpha_u", d.alpha_u.is_some()),
+        ("alpha_v", d.alpha_v.is_some()),
     ];
     let allowed: &[&str] = match d.kind.as_str() {
         "lambert" => &["reflectance", "emission"],
-        "conductor" => &["reflectance", "alpha", "emission"],
+        "conductor" => &["reflectance", "alpha", "emission", "eta", "k", "alpha_u", "alpha_v"],
         "metallic-roughness" => &["base_color", "metallic", "roughness", "specular", "emission"],
         "emitter" => &["emission"],
         other => {
@@ -471,6 +479,31 @@ fn material(
     let emission = color("emission", d.emission, 0.0)?;
     let mut m = match d.kind.as_str() {
         "lambert" => Material::lambert(name, color("reflectance", d.reflectance, 0.8)?),
+        "conductor" if d.eta.is_some() || d.k.is_some() => {
+            // The complex-Fresnel conductor (MaterialKind::Conductor): α given once (isotropic) or per axis.
+            if d.reflectance.is_some() {
+                return Err(e("type \"conductor\" takes either 'reflectance' or 'eta'/'k', not both"));
+            }
+            let a = match (d.alpha, d.alpha_u, d.alpha_v) {
+                (Some(a), None, None) => (a, a),
+                (None, Some(u), Some(v)) => (u, v),
+                _ => return Err(e("a conductor with 'eta'/'k' needs 'alpha', or both 'alpha_u' and 'alpha_v'")),
+            };
+            let (alpha_u, alpha_v) = (unit("alpha_u", Some(a.0), 0.0)?, unit("alpha_v", Some(a.1), 0.0)?);
+            let (eta, k) = (color("eta", d.eta, 1.0)?, color("k", d.k, 0.0)?);
+            if eta.min_element() <= 0.0 {
+                return Err(e("eta must be positive"));
+            }
+            Material {
+                name: name.into(),
+                kind: MaterialKind::Conductor { eta, k, alpha_u, alpha_v },
+                base_color: Vec3::ONE,
+                ..Default::default()
+            }
+        }
+        "conductor" if d.alpha_u.is_some() || d.alpha_v.is_some() => {
+            return Err(e("'alpha_u'/'alpha_v' need 'eta' and 'k' (the Fresnel-1 conductor is isotropic: 'alpha')"));
+        }
         "conductor" => {
             let alpha = unit(
                 "alpha",
