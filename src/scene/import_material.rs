@@ -4,7 +4,7 @@
 //! saying so; retarget this file when new material kinds land.
 
 use super::import_texture::TextureCache;
-use super::{Material, Scene, SceneError, TextureRef};
+use super::{Material, MaterialKind, Scene, SceneError, TextureRef};
 use glam::Vec3;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -84,15 +84,40 @@ pub fn map(
             with_texture(Material::lambert(&desc.name, c), t)
         }
         "conductor" | "roughconductor" | "coatedconductor" => {
-            let f0 = conductor_f0(desc);
             let alpha = alpha_of(desc);
+            let (au, av) = alpha_uv(desc).unwrap_or((alpha, alpha));
             if desc.kind == "coatedconductor" {
                 warn("a conductor without its coat");
-            } else if desc.params.contains_key("eta") || desc.params.contains_key("k") {
-                warn("a Fresnel-free GGX conductor with its normal-incidence reflectance");
             }
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
-            with_texture(Material::conductor(&desc.name, f0 * c, alpha), t)
+            match (desc.params.get("eta"), desc.params.get("k"), t) {
+                // RGB η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
+                (Some(MatParam::Rgb(eta)), Some(MatParam::Rgb(k)), None)
+                    if desc.params.get("reflectance").is_none() =>
+                {
+                    Material {
+                        kind: MaterialKind::Conductor { eta: *eta, k: *k, alpha_u: au, alpha_v: av },
+                        ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
+                    }
+                }
+                // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
+                // normal-incidence reflectance, NAMED_METALS): the complex-Fresnel conductor of that F(0).
+                (_, _, None) => {
+                    let f0 = if desc.params.contains_key("reflectance") { c } else { conductor_f0(desc) * c };
+                    if desc.params.contains_key("eta") && desc.params.get("reflectance").is_none() {
+                        warn("a complex-Fresnel conductor with the named metal's normal-incidence reflectance");
+                    }
+                    Material {
+                        kind: MaterialKind::conductor_from_reflectance(f0, au, av),
+                        ..Material::conductor(&desc.name, f0, alpha)
+                    }
+                }
+                // A textured reflectance: the Fresnel-free GGX conductor, which reads the texture.
+                (_, _, Some(t)) => {
+                    warn("a Fresnel-free GGX conductor with its textured normal-incidence reflectance");
+                    with_texture(Material::conductor(&desc.name, conductor_f0(desc) * c, alpha), Some(t))
+                }
+            }
         }
         "coateddiffuse" | "plastic" | "roughplastic" => {
             let (c, t) = color(desc, &["reflectance", "diffuse_reflectance"], Vec3::splat(0.5), scene, cache)?;
@@ -175,6 +200,21 @@ fn alpha_of(desc: &MaterialDesc) -> f32 {
     }
 }
 
+/// Separate GGX α along u and v (pbrt `uroughness`/`vroughness`, Mitsuba `alpha_u`/`alpha_v`), remapped as
+/// `alpha_of` does; None when the material gives one roughness.
+fn alpha_uv(desc: &MaterialDesc) -> Option<(f32, f32)> {
+    let f = |n: &str| match desc.params.get(n) {
+        Some(MatParam::Float(v)) => Some(v.max(0.0)),
+        _ => None,
+    };
+    if let (Some(u), Some(v)) = (f("alpha_u"), f("alpha_v")) {
+        return Some((u, v));
+    }
+    let (u, v) = (f("uroughness")?, f("vroughness")?);
+    let remap = !matches!(desc.params.get("remaproughness"), Some(MatParam::Bool(false)));
+    Some(if remap { (u.sqrt(), v.sqrt()) } else { (u, v) })
+}
+
 /// Normal-incidence Fresnel reflectance from `eta` / `k` (RGB or a named metal); Cu, pbrt's default, if absent.
 fn conductor_f0(desc: &MaterialDesc) -> Vec3 {
     let named = |s: &str| {
@@ -226,6 +266,19 @@ mod tests {
         let Mapped::Material(m) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
         assert!((m.base_color.x - 0.04).abs() < 1e-6 && m.metallic == 1.0);
         assert!((m.alpha() - 0.2).abs() < 1e-5, "{}", m.alpha());
+        // RGB η and k map to the complex-Fresnel conductor exactly, with no warning.
+        match m.kind {
+            MaterialKind::Conductor { eta, k, alpha_u, alpha_v } => {
+                assert_eq!((eta, k), (Vec3::splat(1.5), Vec3::ZERO));
+                assert!((alpha_u - 0.2).abs() < 1e-5 && (alpha_v - 0.2).abs() < 1e-5);
+            }
+            other => panic!("conductor mapped to {other:?}"),
+        }
+        assert!(w.is_empty(), "{w:?}");
+        // A named metal: its normal-incidence reflectance as a complex-Fresnel conductor, with a warning.
+        let d = desc("conductor", vec![("eta", MatParam::Spectrum("metal-Au-eta".into()))]);
+        let Mapped::Material(m) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
+        assert!(matches!(m.kind, MaterialKind::Conductor { .. }));
         assert_eq!(w.len(), 1);
     }
 }
