@@ -30,6 +30,7 @@ pub const RENDER_FILES: &[&str] = &[
     "bsdf.wgsl",
     "surface.wgsl",
     "lights.wgsl",
+    "light_tree.wgsl",
     "mis.wgsl",
     "estimators.wgsl",
     "integrator.wgsl",

@@ -15,6 +15,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
+    ("light_tree.wgsl", include_str!("../shaders/light_tree.wgsl")),
     ("mis.wgsl", include_str!("../shaders/mis.wgsl")),
     ("estimators.wgsl", include_str!("../shaders/estimators.wgsl")),
     ("integrator.wgsl", include_str!("../shaders/integrator.wgsl")),

@@ -1,0 +1,123 @@
+// light_tree.wgsl — `--light-select tree`: the descent of the light tree src/light_tree.rs builds (its module docs
+// give the importance), and the pmf of a given light from a shading point, for MIS. Called by select_light /
+// light_pmf in lights.wgsl.
+//
+// The lights with a position come first in the light table, `light_tree[0].count` of them; the infinite ones
+// (directional, environment) follow. Each infinite light is chosen with the probability of the whole tree:
+// 1 / (infinite + 1), or 1 / infinite without a tree.
+
+fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if (cos_a > cos_b) { return 1.0; }
+    return cos_a * cos_b + sin_a * sin_b;
+}
+
+fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if (cos_a > cos_b) { return 0.0; }
+    return sin_a * cos_b - cos_a * sin_b;
+}
+
+/// The importance of a node seen from p with normal n; the same arithmetic as light_tree::importance.
+fn light_node_importance(node: LightNode, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let pc = 0.5 * (node.lo + node.hi);
+    let half = node.hi - node.lo;
+    let r2 = 0.25 * dot(half, half);
+    let to_p = p - pc;
+    let dist2 = dot(to_p, to_p);
+    let d2 = max(dist2, r2);
+    var wi = vec3<f32>(0.0, 0.0, 1.0);
+    if (dist2 > 0.0) { wi = to_p / sqrt(dist2); }
+    var cos_w = dot(node.axis, wi);
+    if (node.two_sided != 0u) { cos_w = abs(cos_w); }
+    let sin_w = sqrt(max(1.0 - cos_w * cos_w, 0.0));
+    var sin_b = 0.0;
+    var cos_b = -1.0;
+    if (!(dist2 < r2)) {
+        let s2 = r2 / dist2;
+        sin_b = sqrt(max(s2, 0.0));
+        cos_b = sqrt(max(1.0 - s2, 0.0));
+    }
+    let sin_o = sqrt(max(1.0 - node.cos_o * node.cos_o, 0.0));
+    let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
+    let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
+    let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+    if (cos_p <= node.cos_e) { return 0.0; }
+    var imp = node.phi * cos_p / d2;
+    if (any(n != vec3<f32>(0.0))) {
+        let cos_i = abs(dot(wi, n));
+        let sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
+        imp *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+    }
+    return max(imp, 0.0);
+}
+
+/// The probability of descending into the first child of `node` (by power where neither child has importance,
+/// as light_tree::first_child_probability).
+fn tree_first_child_probability(node: LightNode, node_index: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let c0 = light_tree[node_index + 1u];
+    let c1 = light_tree[node.second];
+    let i0 = light_node_importance(c0, p, n);
+    let i1 = light_node_importance(c1, p, n);
+    if (i0 + i1 > 0.0) { return i0 / (i0 + i1); }
+    if (c0.phi + c1.phi > 0.0) { return c0.phi / (c0.phi + c1.phi); }
+    return 0.5;
+}
+
+/// The probability of choosing the tree (not one of the infinite lights), and how many infinite lights follow it.
+struct TreeSplit {
+    p_tree: f32,
+    bounded: u32,
+    infinite: u32,
+}
+fn tree_split() -> TreeSplit {
+    let bounded = light_tree[0].count;
+    let infinite = params.num_lights - bounded;
+    let choices = infinite + select(0u, 1u, bounded > 0u);
+    return TreeSplit(select(0.0, 1.0 / f32(choices), bounded > 0u), bounded, infinite);
+}
+
+fn tree_select_light(u_in: f32, p: vec3<f32>, n: vec3<f32>) -> u32 {
+    let t = tree_split();
+    var u = u_in;
+    if (u >= t.p_tree) {
+        // One of the infinite lights, uniformly.
+        let k = min(u32((u - t.p_tree) / (1.0 - t.p_tree) * f32(t.infinite)), t.infinite - 1u);
+        return t.bounded + k;
+    }
+    u = min(u / t.p_tree, ONE_MINUS_EPSILON);
+    var i = 0u;
+    var node = light_tree[0];
+    for (var depth = 0u; depth < 32u && node.second != INVALID; depth += 1u) {
+        let p0 = tree_first_child_probability(node, i, p, n);
+        if (u < p0) {
+            u = min(u / p0, ONE_MINUS_EPSILON);
+            i = i + 1u;
+        } else {
+            u = min((u - p0) / (1.0 - p0), ONE_MINUS_EPSILON);
+            i = node.second;
+        }
+        node = light_tree[i];
+    }
+    return node.light;
+}
+
+fn tree_light_pmf(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let t = tree_split();
+    if (light >= t.bounded) { return (1.0 - t.p_tree) / f32(t.infinite); }
+    var trail = scene_light(light).tree_trail;
+    var pmf = t.p_tree;
+    var i = 0u;
+    var node = light_tree[0];
+    for (var depth = 0u; depth < 32u && node.second != INVALID; depth += 1u) {
+        let p0 = tree_first_child_probability(node, i, p, n);
+        if ((trail & 1u) == 0u) {
+            pmf *= p0;
+            i = i + 1u;
+        } else {
+            pmf *= 1.0 - p0;
+            i = node.second;
+        }
+        trail = trail >> 1u;
+        node = light_tree[i];
+    }
+    return pmf;
+}
