@@ -45,10 +45,15 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 /// Applies exposure and a tonemapper to one linear value, giving [0, 1] linear display radiance.
 pub fn tonemap(x: f32, exposure: f32, op: Tonemap) -> f32 {
     let v = x * exposure.exp2();
-    let v = if v.is_finite() { v.max(0.0) } else { 0.0 };
+    // Overflow to +inf is a very bright pixel (white), not a missing one; only NaN is black.
+    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, f32::MAX) };
     match op {
         Tonemap::Clamp => v.min(1.0),
-        Tonemap::Aces => ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0),
+        // The fit is within 1e-6 of its limit 2.51/2.43 (clamped to 1) long before 1e6; beyond, v² overflows.
+        Tonemap::Aces => {
+            let v = v.min(1e6);
+            ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0)
+        }
     }
 }
 
@@ -109,20 +114,44 @@ impl Film {
         image::Rgb32FImage::from_raw(self.width, self.height, data).expect("film size matches its data")
     }
 
-    /// Writes PNG (tonemapped) or EXR (linear) by the extension of `path`. Writes to a temporary file
-    /// first and renames it, so an interrupted write never leaves a truncated image behind.
+    /// Writes PNG (tonemapped) or EXR (linear) by the extension of `path`, replacing what is there (see
+    /// `output_file`: through a temporary file and a rename; symlinks are written through).
     pub fn save(&self, path: &Path, exposure: f32, op: Tonemap) -> Result<(), String> {
-        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
-        let tmp = path.with_extension(format!("{ext}.partial"));
-        let result = match ext.as_str() {
-            "png" => self.to_rgb8(exposure, op).save_with_format(&tmp, image::ImageFormat::Png),
-            "exr" => self.to_rgb32f().save_with_format(&tmp, image::ImageFormat::OpenExr),
-            _ => return Err(format!("{}: unknown output format '.{ext}' (use .png or .exr)", path.display())),
-        };
-        result.map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("{}: could not write the image: {e}", path.display())
-        })?;
-        std::fs::rename(&tmp, path).map_err(|e| format!("{}: could not write the image: {e}", path.display()))
+        self.save_to(&crate::output_file::check(path, true)?, exposure, op, &[])
     }
+
+    /// Writes the image to a checked output, with `attributes` (spp, seed, scene, settings, ...) in its
+    /// header: EXR text attributes, PNG tEXt chunks. A PNG also carries an sRGB chunk: its values are sRGB.
+    pub fn save_to(
+        &self,
+        target: &crate::output_file::OutputTarget,
+        exposure: f32,
+        op: Tonemap,
+        attributes: &[(String, String)],
+    ) -> Result<(), String> {
+        let path = &target.given;
+        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+        match ext.as_str() {
+            "png" => target.write(|tmp| write_png(tmp, &self.to_rgb8(exposure, op), attributes)),
+            "exr" => target.write(|tmp| crate::reference::encode_exr(tmp, self, attributes)),
+            _ => Err(format!("{}: unknown output format '.{ext}' (use .png or .exr)", path.display())),
+        }
+    }
+}
+
+/// An 8-bit sRGB PNG with an sRGB chunk and one tEXt chunk per attribute.
+fn write_png(path: &Path, img: &image::RgbImage, attributes: &[(String, String)]) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), img.width(), img.height());
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    for (k, v) in attributes {
+        // tEXt is Latin-1: keep what fits.
+        let v: String = v.chars().map(|c| if (c as u32) < 256 { c } else { '?' }).collect();
+        encoder.add_text_chunk(k.clone(), v).map_err(|e| e.to_string())?;
+    }
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(img.as_raw()).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())
 }

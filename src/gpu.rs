@@ -104,31 +104,45 @@ fn preference(t: wgpu::DeviceType) -> u32 {
     }
 }
 
+/// The adapter `GpuContext::new` opens: the one named by `WGPU_ADAPTER_NAME`, else the most capable.
+fn choose_adapter(instance: &wgpu::Instance) -> Result<wgpu::Adapter, GpuError> {
+    let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+    if adapters.is_empty() {
+        return Err(GpuError::NoAdapter);
+    }
+    let adapter = match std::env::var("WGPU_ADAPTER_NAME").ok().filter(|s| !s.is_empty()) {
+        Some(wanted) => {
+            let w = wanted.to_lowercase();
+            match adapters.iter().position(|a| a.get_info().name.to_lowercase().contains(&w)) {
+                Some(i) => adapters.swap_remove(i),
+                None => {
+                    let available = adapters.iter().map(|a| a.get_info().name).collect::<Vec<_>>().join(", ");
+                    return Err(GpuError::NoMatchingAdapter { wanted, available });
+                }
+            }
+        }
+        None => {
+            adapters.sort_by_key(|a| preference(a.get_info().device_type));
+            adapters.swap_remove(0)
+        }
+    };
+    Ok(adapter)
+}
+
+/// The storage-binding limit (bytes) of the adapter `GpuContext::new` would open, without opening a device,
+/// or None without one: lets loaders refuse what the device cannot hold before decoding it.
+pub fn chosen_adapter_storage_limit() -> Option<u64> {
+    let adapter = choose_adapter(&vulkan_instance()).ok()?;
+    let l = adapter.limits();
+    Some((l.max_storage_buffer_binding_size as u64).min(l.max_buffer_size))
+}
+
 impl GpuContext {
     /// Opens a headless device: the adapter named by `WGPU_ADAPTER_NAME` (substring, case-insensitive)
     /// or else the most capable one (discrete > integrated > ... > CPU).
     pub fn new() -> Result<Self, GpuError> {
         let instance = vulkan_instance();
-        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
-        if adapters.is_empty() {
-            return Err(GpuError::NoAdapter);
-        }
-        let adapter = match std::env::var("WGPU_ADAPTER_NAME").ok().filter(|s| !s.is_empty()) {
-            Some(wanted) => {
-                let w = wanted.to_lowercase();
-                match adapters.iter().position(|a| a.get_info().name.to_lowercase().contains(&w)) {
-                    Some(i) => adapters.swap_remove(i),
-                    None => {
-                        let available = adapters.iter().map(|a| a.get_info().name).collect::<Vec<_>>().join(", ");
-                        return Err(GpuError::NoMatchingAdapter { wanted, available });
-                    }
-                }
-            }
-            None => {
-                adapters.sort_by_key(|a| preference(a.get_info().device_type));
-                adapters.swap_remove(0)
-            }
-        };
+        let adapter = choose_adapter(&instance)?;
         Self::from_adapter(instance, adapter)
     }
 

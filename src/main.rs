@@ -62,14 +62,18 @@ enum Command {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneSpec,
-    /// Output file; .png (sRGB, tonemapped) or .exr (linear float32 RGB).
+    /// Output file; .png (sRGB, tonemapped) or .exr (linear float32 RGB). Both record spp, seed, scene and
+    /// settings in their header; the image is written through a temporary file, and a symlink through.
     #[arg(short, long, default_value = "render.png")]
     output: PathBuf,
-    /// Samples per pixel.
-    #[arg(long, conflicts_with = "time")]
+    /// Replace the output file even if it is read-only.
+    #[arg(long)]
+    force: bool,
+    /// Samples per pixel [default: 64 unless --time is given].
+    #[arg(long, conflicts_with = "time", value_parser = mislab::cli_values::spp)]
     spp: Option<u32>,
     /// Render for this many seconds (after start-up and shader compilation).
-    #[arg(long)]
+    #[arg(long, value_parser = mislab::cli_values::seconds)]
     time: Option<f64>,
     /// Tonemapper for PNG output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
@@ -115,7 +119,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render(args),
         Command::Info { scene } => info(scene),
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
-        Command::Reference(args) => mislab::reference::run(&args).map(|_| 0).map_err(bad),
+        Command::Reference(args) => mislab::reference::run(&args).map_err(bad),
         Command::Merge(args) => mislab::state::merge::run(&args).map_err(bad),
         Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
         Command::Stress { filter } => stress(filter.as_deref()),
@@ -155,6 +159,9 @@ fn stress(filter: Option<&str>) -> Result<u8, Failure> {
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let outcomes =
         mislab::stress::run(&ctx, filter, |o| eprintln!("{}", mislab::stress::progress_line(o))).map_err(bad)?;
+    if outcomes.is_empty() {
+        return Err(bad(format!("--filter '{}' matches no stress case", filter.unwrap_or_default())));
+    }
     println!("{}", mislab::stress::table(&outcomes));
     let failed = outcomes.iter().filter(|o| !o.pass).count();
     println!(
@@ -174,6 +181,11 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     if !matches!(ext.as_deref(), Some("png") | Some("exr")) {
         return Err(bad(format!("{}: unknown output format (use .png or .exr)", args.output.display())));
     }
+    // Before any work: a missing directory or a read-only file would otherwise be found after the render.
+    let target = mislab::output_file::check(&args.output, args.force).map_err(bad)?;
+    if ext.as_deref() == Some("exr") && settings.exposure != 0.0 {
+        eprintln!("note: --exposure is ignored for EXR output (linear radiance); it applies to PNG and the viewer");
+    }
     let budget = match (args.spp, args.time) {
         (Some(0), _) => return Err(bad("--spp must be at least 1")),
         (Some(n), _) => {
@@ -192,8 +204,8 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     // State flags and the state to resume first: a bad state file fails before any scene or device work.
     let mut session = mislab::state::session::Session::open(&args.state, args.spp, &args.output).map_err(bad)?;
     let t_start = Instant::now();
-    // Catch Ctrl-C from the start: during start-up it stops before rendering, afterwards it writes
-    // what has accumulated.
+    // Catch Ctrl-C (and SIGTERM, SIGHUP: the ctrlc crate's `termination` feature) from the start: during
+    // start-up it stops before rendering, afterwards it writes what has accumulated.
     let interrupt = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupt.clone();
@@ -215,7 +227,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     let t_device = Instant::now();
     let data = SceneData::build(&scene);
     eprintln!(
-        "scene: {} — {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights; BVH {} nodes built in {:.1} ms, {:.1} MiB ({:.0} B/triangle)",
+        "scene: {} — {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights; BVH {} nodes built in {:.1} ms, {:.1} MiB{}",
         scene.name,
         scene.triangle_count(),
         scene.spheres.len(),
@@ -226,7 +238,11 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         data.bvh_nodes.len(),
         data.bvh_seconds * 1e3,
         data.bvh_bytes() as f64 / (1 << 20) as f64,
-        data.bvh_bytes() as f64 / scene.triangle_count().max(1) as f64,
+        // Per triangle only where there are triangles (the BVH also holds spheres and quads).
+        match scene.triangle_count() {
+            0 => String::new(),
+            n => format!(" ({:.0} B/triangle)", data.bvh_bytes() as f64 / n as f64),
+        },
     );
     if let Some(w) = unreachable_light_warning(&data, &settings) {
         eprintln!("warning: {w}");
@@ -280,7 +296,8 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         eprintln!("wrote state {} (samples {}..{})", s.path().display(), s.range().0, renderer.samples());
     }
     let film = renderer.film(&ctx).map_err(|e| bad(e.to_string()))?;
-    film.save(&args.output, settings.exposure, args.tonemap).map_err(bad)?;
+    let attributes = mislab::reference::header_attributes(&args.scene, &settings, &stats);
+    film.save_to(&target, settings.exposure, args.tonemap, &attributes).map_err(bad)?;
     eprintln!(
         "{} spp in {:.2} s: {:.2} M samples/s, {:.2} Mrays/s, {} NaN/Inf samples",
         stats.spp,

@@ -12,6 +12,8 @@ use crate::scene::{Scene, SceneSpec};
 use crate::settings::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Seed of references (distinct from the seeds 0, 1, … that `mislab bench` measures, so the reference's
@@ -26,11 +28,14 @@ pub struct ReferenceArgs {
     /// Output EXR.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Samples per pixel.
-    #[arg(long, conflicts_with = "time", required_unless_present = "time")]
-    pub spp: Option<u32>,
-    /// Render for this many seconds instead (after compilation).
+    /// Replace the output file even if it is read-only.
     #[arg(long)]
+    pub force: bool,
+    /// Samples per pixel (this or --time is required).
+    #[arg(long, conflicts_with = "time", required_unless_present = "time", value_parser = crate::cli_values::spp)]
+    pub spp: Option<u32>,
+    /// Render for this many seconds instead (after compilation; this or --spp is required).
+    #[arg(long, value_parser = crate::cli_values::seconds)]
     pub time: Option<f64>,
     /// Image width.
     #[arg(long, default_value_t = 512)]
@@ -53,7 +58,8 @@ pub struct ReferenceArgs {
     /// Light selection.
     #[arg(long, value_enum, default_value_t = LightSelect::Uniform)]
     pub light_select: LightSelect,
-    /// Seed.
+    /// Seed (0 to 4294967295). The default, 0x5eedf00d, differs from the seeds 0, 1, … that `mislab bench`
+    /// measures, so the reference's own error is independent of theirs.
     #[arg(long, default_value_t = REFERENCE_SEED)]
     pub seed: u32,
     /// Render only the K-th (from 0) of N sample ranges of --spp into a state file (--state, default: the
@@ -89,11 +95,13 @@ pub fn render_reference(
     budget: Budget,
     dispatch_spp: u32,
 ) -> Result<(Film, RenderStats), String> {
-    render_reference_from(ctx, SceneData::build(scene), scene, settings, budget, dispatch_spp, 0)
+    render_reference_from(ctx, SceneData::build(scene), scene, settings, budget, dispatch_spp, 0, &AtomicBool::new(false))
 }
 
 /// `render_reference` of the sample indices from `first` on (`--part`: `state::session::part_range`), with the
-/// scene's data already built.
+/// scene's data already built; it stops early with what has accumulated (`RenderStats::interrupted`) once `stop`
+/// is set (Ctrl-C, SIGTERM, SIGHUP).
+#[allow(clippy::too_many_arguments)]
 pub fn render_reference_from(
     ctx: &GpuContext,
     data: SceneData,
@@ -102,6 +110,7 @@ pub fn render_reference_from(
     budget: Budget,
     dispatch_spp: u32,
     first: u32,
+    stop: &AtomicBool,
 ) -> Result<(Film, RenderStats), String> {
     let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| e.to_string())?;
     let mut r = Renderer::new(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?;
@@ -115,7 +124,12 @@ pub fn render_reference_from(
         let (mut seconds, mut rays) = (0.0, 0u64);
         // Submissions of about a second, so a time budget is met closely.
         let mut chunk = dispatch;
+        let mut interrupted = false;
         loop {
+            if stop.load(Ordering::SeqCst) && r.samples() > first {
+                interrupted = true;
+                break;
+            }
             let n = match budget {
                 Budget::Samples(total) => chunk.min(total - (r.samples() - first)),
                 Budget::Time(t) => {
@@ -144,7 +158,7 @@ pub fn render_reference_from(
         let film = r.film(ctx).map_err(|e| e.to_string())?;
         if film.is_complete(r.samples() - first) {
             let spp = r.samples() - first;
-            let stats = RenderStats { spp, seconds, rays, nonfinite: r.nonfinite_total(), interrupted: false };
+            let stats = RenderStats { spp, seconds, rays, nonfinite: r.nonfinite_total(), interrupted };
             return Ok((film, stats));
         }
         if dispatch == 1 {
@@ -162,6 +176,8 @@ pub fn header_attributes(scene: &SceneSpec, settings: &Settings, stats: &RenderS
         ("spp".into(), stats.spp.to_string()),
         ("renderSeconds".into(), format!("{:.3}", stats.seconds)),
         ("nonfiniteSamples".into(), stats.nonfinite.to_string()),
+        ("seed".into(), settings.seed.to_string()),
+        ("interrupted".into(), stats.interrupted.to_string()),
         ("scene".into(), scene.scene.clone()),
         ("environment".into(), scene.env.as_ref().map(|p| p.display().to_string()).unwrap_or_default()),
         ("envScale".into(), scene.env_scale.to_string()),
@@ -179,11 +195,16 @@ fn text(s: &str) -> exr::meta::attribute::Text {
 }
 
 /// Writes linear RGB float32 EXR with `attributes` as text attributes of the layer (written to a temporary
-/// file and renamed).
+/// file and renamed; see `output_file`).
 pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), String> {
+    crate::output_file::check(path, true)?.write(|tmp| encode_exr(tmp, film, attributes))
+}
+
+/// Encodes `film` as linear RGB float32 EXR at `path`, with `attributes` as text attributes of the layer.
+pub fn encode_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), String> {
     use exr::prelude::*;
     let (w, h) = (film.width as usize, film.height as usize);
-    let mut layer_attributes = LayerAttributes::named("reference");
+    let mut layer_attributes = LayerAttributes::named("mislab");
     layer_attributes.software_name = Some(text("mislab"));
     for (k, v) in attributes {
         layer_attributes.other.insert(text(k), AttributeValue::Text(text(v)));
@@ -198,12 +219,7 @@ pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> R
             (c[0], c[1], c[2])
         }),
     );
-    let tmp = path.with_extension("exr.partial");
-    Image::from_layer(layer)
-        .write()
-        .to_file(&tmp)
-        .map_err(|e| format!("{}: could not write the EXR: {e}", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+    Image::from_layer(layer).write().to_file(path).map_err(|e| format!("EXR: {e}"))
 }
 
 /// A reference read back: size, linear RGB pixels, and its text attributes.
@@ -241,12 +257,14 @@ pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
     Ok(ReferenceImage { width, height, pixels, attributes })
 }
 
-/// Runs `mislab reference`.
-pub fn run(args: &ReferenceArgs) -> Result<(), String> {
+/// Runs `mislab reference`; returns the exit code (0, or 130 when interrupted after writing what it had).
+pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("exr") {
         return Err(format!("{}: a reference is written as .exr", args.output.display()));
     }
+    // Before any work: an unwritable output would otherwise be found after the render.
+    let target = crate::output_file::check(&args.output, args.force)?;
     let budget = match (args.spp, args.time) {
         (Some(0), _) => return Err("--spp must be at least 1".into()),
         (Some(n), _) => Budget::Samples(n),
@@ -266,6 +284,12 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
     };
     let settings = Settings { seed: args.seed, ..reference_settings(&base) };
     settings.validate()?;
+    // Ctrl-C, SIGTERM and SIGHUP stop the render; what has accumulated is written and marked interrupted.
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let flag = stop.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
     let ctx = GpuContext::new().map_err(|e| e.to_string())?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let scene = args.scene.load()?;
@@ -278,9 +302,10 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
     if range.0 == range.1 {
         return Err(format!("--part of --spp {total} holds no samples (use at most {total} parts)"));
     }
-    let (film, stats) = render_reference_from(&ctx, data, &scene, &settings, budget, 0, range.0)?;
-    write_exr(&args.output, &film, &header_attributes(&args.scene, &settings, &stats))?;
-    if args.part.is_some() || args.state.is_some() {
+    let (film, stats) = render_reference_from(&ctx, data, &scene, &settings, budget, 0, range.0, &stop)?;
+    let attributes = header_attributes(&args.scene, &settings, &stats);
+    film.save_to(&target, 0.0, crate::film::Tonemap::Clamp, &attributes)?;
+    if (args.part.is_some() || args.state.is_some()) && !stats.interrupted {
         let header = crate::state::StateHeader {
             scene: args.scene.scene.clone(),
             scene_hash,
@@ -310,5 +335,12 @@ pub fn run(args: &ReferenceArgs) -> Result<(), String> {
         stats.nonfinite,
         args.output.display()
     );
-    Ok(())
+    if stats.interrupted {
+        eprintln!(
+            "interrupted: wrote the {} samples per pixel accumulated so far (the header says interrupted = true)",
+            stats.spp
+        );
+        return Ok(130);
+    }
+    Ok(0)
 }

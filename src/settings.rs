@@ -192,11 +192,11 @@ pub struct Settings {
     /// it off).
     #[arg(long, default_value_t = Settings::default().rr_depth)]
     pub rr_depth: u32,
-    /// Seed of every random number.
+    /// Seed of every random number (an integer from 0 to 4294967295).
     #[arg(long, default_value_t = Settings::default().seed)]
     pub seed: u32,
-    /// Exposure in stops for PNG output and display (EXR output is linear radiance and ignores it).
-    #[arg(long, allow_hyphen_values = true, default_value_t = Settings::default().exposure)]
+    /// Exposure in stops (-64 to 64) for PNG output and display (EXR output is linear radiance and ignores it).
+    #[arg(long, allow_hyphen_values = true, default_value_t = Settings::default().exposure, value_parser = crate::cli_values::exposure)]
     pub exposure: f32,
 }
 
@@ -242,6 +242,9 @@ impl Settings {
         }
         if self.rr_depth == 0 {
             return Err("--rr-depth must be at least 1".into());
+        }
+        if !(self.exposure.is_finite() && self.exposure.abs() <= crate::cli_values::MAX_EXPOSURE) {
+            return Err(format!("exposure {} is out of range (-64..=64 stops)", self.exposure));
         }
         if self.max_depth == 0 || self.max_depth > 256 {
             return Err(format!("--max-depth {} is out of range (1..=256)", self.max_depth));

@@ -273,10 +273,10 @@ fn multiple_scenes_and_scene_option() {
     let default = load_ok(&path);
     assert_eq!(default.triangle_count(), expected(&v, Some(1)).triangles);
     assert_eq!(default.triangle_count(), 2);
-    let first = load(&path, &LoadOptions { gltf_scene: Some(0) }).unwrap();
+    let first = load(&path, &LoadOptions { gltf_scene: Some(0), ..Default::default() }).unwrap();
     assert_eq!(first.triangle_count(), expected(&v, Some(0)).triangles);
     assert_eq!(first.triangle_count(), 1);
-    let err = load(&path, &LoadOptions { gltf_scene: Some(2) }).unwrap_err().to_string();
+    let err = load(&path, &LoadOptions { gltf_scene: Some(2), ..Default::default() }).unwrap_err().to_string();
     assert!(err.contains("MultipleScenes.gltf") && err.contains("scene 2") && err.contains("2 scene"), "{err}");
 }
 

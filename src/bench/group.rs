@@ -190,6 +190,7 @@ impl BenchGroup {
             env: self.env.clone(),
             env_scale: self.env_scale,
             env_rotation: self.env_rotation,
+            allow_outside_paths: false,
         }
     }
 

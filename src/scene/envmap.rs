@@ -30,19 +30,17 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
             )))
         }
     };
-    let file = std::fs::File::open(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => err("environment map not found".into()),
-        _ => err(format!("cannot open environment map: {e}")),
-    })?;
-    let metadata = file.metadata().map_err(|e| err(format!("cannot read environment map: {e}")))?;
-    if metadata.is_dir() {
-        return Err(err("is a directory, not an environment map".into()));
+    // A regular file only (a FIFO would block, /dev/zero never ends), and within the documented size limit.
+    let (file, len) = crate::input_file::open_regular(path).map_err(|m| err(format!("environment map {m}")))?;
+    let limit = crate::input_file::MAX_ENVMAP_BYTES;
+    if len > limit {
+        return Err(err(format!("environment map is {len} bytes, over the limit of {limit} bytes")));
     }
-    if metadata.len() == 0 {
+    if len == 0 {
         return Err(err("empty file (0 bytes)".into()));
     }
     if format == image::ImageFormat::Hdr {
-        check_hdr_header(&file, metadata.len()).map_err(err)?;
+        check_hdr_header(&file, len).map_err(err)?;
     }
     // Decoders can panic on corrupt data (an overflowing run-length multiplier in the Radiance decoder, for
     // one): that is an error about this file, not a crash.

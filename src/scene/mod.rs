@@ -369,6 +369,11 @@ impl Scene {
 pub struct LoadOptions {
     /// glTF scene index (`--gltf-scene N`); None = the file's default scene (or scene 0).
     pub gltf_scene: Option<usize>,
+    /// Follow glTF URIs that are absolute or leave the file's directory (`--allow-outside-paths`).
+    pub allow_outside_paths: bool,
+    /// Bytes the scene's RGBA8 texels may take (the device's storage-binding limit when known); images
+    /// that would not fit are refused before they are decoded.
+    pub max_texel_bytes: Option<u64>,
 }
 
 /// Loads a scene from a file (`.gltf`, `.glb`, `.toml`) or a built-in name (see `builtin::NAMES`).
@@ -378,11 +383,20 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         return Ok(scene);
     }
     let path = Path::new(name_or_path);
-    if !path.exists() {
+    // symlink_metadata: a dangling link or a link loop exists, and open_regular says which it is.
+    if path.symlink_metadata().is_err() {
         let names = builtin::NAMES.join(", ");
         return Err(SceneError::new(path, format!("no such file, and not a built-in scene (built-ins: {names})")));
     }
+    // Anything but a regular file (a FIFO would block, /dev/zero never ends) is refused before a loader opens it.
+    crate::input_file::open_regular(path).map_err(|m| SceneError::new(path, m))?;
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+    if ext.is_empty() {
+        return Err(SceneError::new(
+            path,
+            "has no file extension: cannot tell its format (expected .gltf, .glb or .toml)",
+        ));
+    }
     let result = catch_quietly(|| match ext.as_str() {
         "gltf" | "glb" => gltf::load(path, options),
         "toml" => toml::load(path, options),
@@ -390,7 +404,10 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         "xml" => mitsuba::load(path),
         _ => Err(SceneError::new(
             path,
-            format!("unknown scene format '.{ext}' (expected .gltf, .glb, .toml, .pbrt or Mitsuba .xml)"),
+            format!(
+                "unknown scene format '.{}' (expected .gltf, .glb, .toml, .pbrt or Mitsuba .xml)",
+                crate::input_file::clip(&ext, 20)
+            ),
         )),
     });
     match result {

@@ -17,12 +17,16 @@ pub struct SceneSpec {
     /// Light the scene with this equirectangular .hdr/.exr (replaces its environment).
     #[arg(long)]
     pub env: Option<PathBuf>,
-    /// Scale of the --env map.
-    #[arg(long, default_value_t = 1.0)]
+    /// Scale of the --env map (finite, 0 to 1e30).
+    #[arg(long, default_value_t = 1.0, value_parser = crate::cli_values::env_scale)]
     pub env_scale: f32,
     /// Rotation of the --env map about +Y, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::cli_values::degrees)]
     pub env_rotation: f32,
+    /// Let glTF buffer and image URIs be absolute paths or lead outside the glTF file's directory (by `..` or
+    /// a symbolic link); without it such a URI is an error.
+    #[arg(long)]
+    pub allow_outside_paths: bool,
 }
 
 impl Default for SceneSpec {
@@ -34,7 +38,14 @@ impl Default for SceneSpec {
 impl SceneSpec {
     /// A scene file or built-in name with no overrides.
     pub fn named(scene: &str) -> SceneSpec {
-        SceneSpec { scene: scene.into(), gltf_scene: None, env: None, env_scale: 1.0, env_rotation: 0.0 }
+        SceneSpec {
+            scene: scene.into(),
+            gltf_scene: None,
+            env: None,
+            env_scale: 1.0,
+            env_rotation: 0.0,
+            allow_outside_paths: false,
+        }
     }
 
     /// Loads the scene and applies the environment override; prints the loader's warnings once. A scene with
@@ -46,7 +57,13 @@ impl SceneSpec {
         if !self.env_rotation.is_finite() {
             return Err(format!("--env-rotation {} must be a finite number of degrees", self.env_rotation));
         }
-        let mut s = load(&self.scene, &LoadOptions { gltf_scene: self.gltf_scene }).map_err(|e| e.to_string())?;
+        let options = LoadOptions {
+            gltf_scene: self.gltf_scene,
+            allow_outside_paths: self.allow_outside_paths,
+            // Refuse textures the device cannot hold before decoding them (the limit costs no device).
+            max_texel_bytes: crate::gpu::chosen_adapter_storage_limit(),
+        };
+        let mut s = load(&self.scene, &options).map_err(|e| e.to_string())?;
         if let Some(env) = &self.env {
             let (map, warnings) = envmap::load_envmap(env).map_err(|e| e.to_string())?;
             s.warnings.extend(warnings);

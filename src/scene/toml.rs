@@ -17,11 +17,8 @@ use std::sync::Arc;
 /// Loads a TOML scene. Relative paths inside it (environment maps, includes) are resolved against its directory.
 /// Errors name the file and, where the problem is in the file, its line.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => SceneError::new(path, "no such file"),
-        std::io::ErrorKind::InvalidData => SceneError::new(path, "not UTF-8 text"),
-        _ => SceneError::new(path, format!("cannot read: {e}")),
-    })?;
+    let text = crate::input_file::read_bounded_text(path, crate::input_file::MAX_TOML_BYTES)
+        .map_err(|m| SceneError::new(path, m))?;
     let ctx = Ctx { path, text: &text, dir: path.parent().unwrap_or(Path::new("")).to_path_buf() };
     let file: FileDef = ::toml::from_str(&text).map_err(|e| {
         let at = e.span().map(|s| ctx.position(s.start)).unwrap_or_default();
@@ -673,8 +670,9 @@ fn include(
     let matrix = Mat4::from_scale_rotation_translation(scale, rotation, translate);
 
     let path = ctx.resolve(&d.gltf);
-    if !path.is_file() {
-        return Err(e(&format!("glTF file {} not found", path.display())));
+    // The same check every input gets (a FIFO, a directory or /dev/zero is named as what it is).
+    if let Err(m) = crate::input_file::open_regular(&path) {
+        return Err(e(&format!("glTF file {} {m}", path.display())));
     }
     // The include's own `scene` (not the command line's --gltf-scene, which is for a top-level glTF file).
     let mut options = options.clone();

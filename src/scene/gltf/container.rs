@@ -77,10 +77,90 @@ pub(super) fn parse_json(bytes: &[u8]) -> Res<json::Root> {
         // Keep the first error: it has a line and column, the retry's would not.
         Err(e) => parse_lenient(bytes).ok_or_else(|| format!("invalid glTF JSON: {e}"))?,
     };
+    // gltf-json reads indices as u64 and keeps the low 32 bits: range-check them as the JSON numbers they are.
+    if let Ok(value) = json::deserialize::from_slice::<json::Value>(bytes) {
+        check_index_range(&value, &mut String::new())?;
+    }
     if !root.asset.version.starts_with("2.") {
         return Err(format!("glTF version '{}' is not supported (only 2.x)", root.asset.version));
     }
     Ok(root)
+}
+
+/// Keys whose values (a number, an array of numbers, or for `attributes`/`targets` an object of numbers) are
+/// indices into one of the root's arrays.
+const INDEX_KEYS: &[&str] = &[
+    "scene",
+    "nodes",
+    "camera",
+    "children",
+    "skin",
+    "mesh",
+    "indices",
+    "material",
+    "bufferView",
+    "buffer",
+    "source",
+    "sampler",
+    "index",
+    "joints",
+    "skeleton",
+    "inverseBindMatrices",
+    "input",
+    "output",
+    "node",
+    "light",
+    "attributes",
+    "targets",
+    "texCoord",
+];
+
+/// Refuses any index of 2^32 or more (which gltf-json would wrap to a small, valid-looking one), naming where.
+fn check_index_range(v: &json::Value, at: &mut String) -> Res<()> {
+    fn numbers(v: &json::Value, at: &str) -> Res<()> {
+        match v {
+            json::Value::Number(n) if n.as_u64().is_some_and(|i| i > u32::MAX as u64) => Err(format!(
+                "{at}: index {n} does not exist (glTF indices are below 2^32; the file's arrays are far shorter)"
+            )),
+            json::Value::Array(items) => {
+                items.iter().enumerate().try_for_each(|(i, item)| numbers(item, &format!("{at}[{i}]")))
+            }
+            json::Value::Object(map) => map.iter().try_for_each(|(k, item)| match item {
+                json::Value::Number(_) => numbers(item, &format!("{at}.{}", crate::input_file::clip(k, 40))),
+                _ => Ok(()),
+            }),
+            _ => Ok(()),
+        }
+    }
+    match v {
+        json::Value::Object(map) => {
+            for (k, item) in map {
+                if k == "extras" {
+                    continue; // free-form application data
+                }
+                let len = at.len();
+                if !at.is_empty() {
+                    at.push('.');
+                }
+                at.push_str(&crate::input_file::clip(k, 40));
+                if INDEX_KEYS.contains(&k.as_str()) {
+                    numbers(item, at)?;
+                }
+                check_index_range(item, at)?;
+                at.truncate(len);
+            }
+        }
+        json::Value::Array(items) => {
+            for (i, item) in items.iter().enumerate() {
+                let len = at.len();
+                at.push_str(&format!("[{i}]"));
+                check_index_range(item, at)?;
+                at.truncate(len);
+            }
+        }
+        _ => {}
+    }
+    Ok(())
 }
 
 /// Retries after filling in what the spec makes optional but gltf-json 1.4.1 requires (`scene.nodes`).
@@ -110,20 +190,41 @@ pub(super) fn check_extensions(root: &json::Root, notes: &mut Notes) -> Res<()> 
     Ok(())
 }
 
+/// Where a glTF file's URIs may lead: files under its own directory, unless the user allows others
+/// (`--allow-outside-paths`).
+#[derive(Clone, Copy)]
+pub(super) struct Uris<'p> {
+    /// The glTF file's directory.
+    pub base: &'p Path,
+    /// Follow absolute paths, `..` and symlinks out of `base`.
+    pub allow_outside: bool,
+}
+
+/// A URI as echoed in messages: cut (a hostile file can hold megabytes in one), never file content.
+fn shown(uri: &str) -> String {
+    crate::input_file::clip(uri, 80)
+}
+
 /// Reads every buffer (GLB chunk, external file or data URI) and checks it against its declared byteLength.
-pub(super) fn load_buffers(root: &json::Root, bin: Option<&[u8]>, is_glb: bool, base: &Path) -> Res<Vec<Vec<u8>>> {
+/// An external file is read only up to the declared length (itself checked against the limit first), so a
+/// buffer naming a huge or endless file never reads more than it declared.
+pub(super) fn load_buffers(root: &json::Root, bin: Option<&[u8]>, is_glb: bool, uris: Uris) -> Res<Vec<Vec<u8>>> {
+    use crate::input_file::{read_prefix, MAX_GLTF_BYTES};
     let mut out = Vec::with_capacity(root.buffers.len());
     for (i, buffer) in root.buffers.iter().enumerate() {
         let what = format!("buffer {i}{}", quoted(&buffer.name));
+        let declared = buffer.byte_length.0;
+        if declared > MAX_GLTF_BYTES {
+            return Err(format!("{what}: byteLength {declared} exceeds the limit of {MAX_GLTF_BYTES} bytes"));
+        }
         let mut data = match (&buffer.uri, bin) {
-            (Some(uri), _) => fetch_uri(base, uri).map_err(|m| format!("{what}: {m}"))?,
+            (Some(uri), _) => fetch_uri(uris, uri, |p| read_prefix(p, declared)).map_err(|m| format!("{what}: {m}"))?,
             (None, Some(bin)) if i == 0 => bin.to_vec(),
             (None, None) if i == 0 && is_glb => {
                 return Err(format!("{what} has no uri, and the GLB file has no BIN chunk to hold its data"))
             }
             (None, _) => return Err(format!("{what} has no uri (only a .glb's first buffer may omit it)")),
         };
-        let declared = buffer.byte_length.0;
         if (data.len() as u64) < declared {
             return Err(format!("{what}: byteLength is {declared} but only {} bytes of data are present", data.len()));
         }
@@ -133,22 +234,65 @@ pub(super) fn load_buffers(root: &json::Root, bin: Option<&[u8]>, is_glb: bool, 
     Ok(out)
 }
 
-/// Bytes behind a URI: a base64 `data:` URI or a file path relative to the glTF file.
-pub(super) fn fetch_uri(base: &Path, uri: &str) -> Res<Vec<u8>> {
+/// Bytes behind a URI: a base64 `data:` URI, or a file path relative to the glTF file read with `read`.
+pub(super) fn fetch_uri(uris: Uris, uri: &str, read: impl Fn(&Path) -> Res<Vec<u8>>) -> Res<Vec<u8>> {
     if let Some(rest) = uri.strip_prefix("data:") {
         return decode_data_uri(rest);
     }
     let scheme = uri.split_once(':').map(|(s, _)| s).unwrap_or("");
     if scheme.len() > 1 && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c)) {
+        let uri = shown(uri);
         return Err(format!("URI '{uri}' is neither a relative file path nor a data: URI (nothing is downloaded)"));
     }
-    let decoded = base.join(percent_decode(uri).unwrap_or_else(|| uri.to_string()));
-    match std::fs::read(&decoded) {
-        Ok(bytes) => Ok(bytes),
-        // Some exporters write file names without percent-encoding; try the URI as written too.
-        Err(_) if base.join(uri).is_file() => std::fs::read(base.join(uri)).map_err(|e| e.to_string()),
-        Err(e) => Err(format!("cannot read '{}': {e}", decoded.display())),
+    let decoded = percent_decode(uri).unwrap_or_else(|| uri.to_string());
+    // Some exporters write file names without percent-encoding; try the URI as written too.
+    let path = match resolve(uris, &decoded)? {
+        p if p.symlink_metadata().is_err() && decoded != uri => {
+            let raw = resolve(uris, uri)?;
+            if raw.symlink_metadata().is_ok() {
+                raw
+            } else {
+                p
+            }
+        }
+        p => p,
+    };
+    read(&path).map_err(|m| format!("'{}' {m}", shown(&path.display().to_string())))
+}
+
+/// The file a relative URI names, refusing (unless allowed) absolute paths and paths that climb out of the
+/// glTF file's directory, by `..` or through a symbolic link.
+fn resolve(uris: Uris, rel: &str) -> Res<std::path::PathBuf> {
+    use std::path::Component;
+    let hint = "(resolved relative to the glTF file; allow it with --allow-outside-paths)";
+    let p = Path::new(rel);
+    let path = uris.base.join(p);
+    if uris.allow_outside {
+        return Ok(path);
     }
+    let mut depth = 0i64;
+    for c in p.components() {
+        match c {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => {
+                depth -= 1;
+                if depth < 0 {
+                    return Err(format!("URI '{}' leads outside the glTF file's directory {hint}", shown(rel)));
+                }
+            }
+            Component::RootDir | Component::Prefix(_) => {
+                return Err(format!("URI '{}' is an absolute path {hint}", shown(rel)));
+            }
+        }
+    }
+    if let (Ok(target), Ok(base)) = (path.canonicalize(), uris.base.canonicalize()) {
+        if !target.starts_with(&base) {
+            let rel = shown(rel);
+            return Err(format!("URI '{rel}' leads outside the glTF file's directory through a symbolic link {hint}"));
+        }
+    }
+    Ok(path)
 }
 
 fn decode_data_uri(rest: &str) -> Res<Vec<u8>> {

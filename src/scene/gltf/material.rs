@@ -149,12 +149,16 @@ impl Loader<'_> {
             .ok_or_else(|| format!("{label}: image {index} does not exist (the file has {count} images)"))?;
         let what = format!("image {index} ({})", image_name(root, index));
         let bytes = match (&image.uri, image.buffer_view) {
-            (Some(uri), _) => fetch_uri(self.base, uri),
+            (Some(uri), _) => {
+                fetch_uri(self.uris(), uri, |p| crate::input_file::read_bounded(p, crate::input_file::MAX_IMAGE_BYTES))
+            }
             (None, Some(view)) => self.view(view.value()).map(|(bytes, _)| bytes.to_vec()),
             (None, None) => Err("has neither a uri nor a bufferView".into()),
         }
         .map_err(|m| format!("{what}: {m}"))?;
-        let decoded = Rc::new(decode_image(&bytes).map_err(|m| format!("{what}: {m}"))?);
+        let left = self.texel_limit.saturating_sub(self.texel_used);
+        let decoded = Rc::new(decode_image(&bytes, left, self.texel_limit).map_err(|m| format!("{what}: {m}"))?);
+        self.texel_used += 4 * decoded.texels.len() as u64;
         self.images.insert(index, decoded.clone());
         Ok(decoded)
     }
@@ -222,13 +226,24 @@ fn image_name(root: &json::Root, index: usize) -> String {
     }
 }
 
-/// Decodes PNG/JPEG bytes to RGBA8, refusing images above the size limit before decoding them.
-fn decode_image(bytes: &[u8]) -> Res<Decoded> {
+/// Decodes PNG/JPEG bytes to RGBA8, refusing images above the size limit, or whose texels would not fit in
+/// what is left of the device's texel buffer (`budget` bytes), from their declared size before decoding them.
+fn decode_image(bytes: &[u8], budget: u64, limit: u64) -> Res<Decoded> {
     let reader = || image::ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string());
     let (width, height) = reader()?.into_dimensions().map_err(|e| format!("cannot decode the image: {e}"))?;
     if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
         return Err(format!(
             "{width}×{height} texels exceeds the texture size limit of {MAX_TEXTURE_SIZE} texels per side"
+        ));
+    }
+    let need = 4 * width as u64 * height as u64;
+    if need > budget {
+        let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+        return Err(format!(
+            "{width}×{height} texels need {:.1} MiB ({need} bytes) as RGBA8, more than the {:.1} MiB left for the scene's texels of the device's max_storage_buffer_binding_size of {} MiB ({limit} bytes); refused before decoding",
+            mib(need),
+            mib(budget),
+            limit >> 20
         ));
     }
     let image = reader()?.decode().map_err(|e| format!("cannot decode the image: {e}"))?;

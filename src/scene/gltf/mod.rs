@@ -28,7 +28,7 @@ mod notes;
 
 use super::{Camera, LoadOptions, Scene, SceneError};
 use camera_light::frame_meshes;
-use container::{check_extensions, load_buffers, parse_json, split_container};
+use container::{check_extensions, load_buffers, parse_json, split_container, Uris};
 use glam::Mat4;
 use gltf::json;
 use material::{Decoded, TexKey};
@@ -40,6 +40,9 @@ use std::rc::Rc;
 
 /// Largest texture side we accept (the GPU texture limit we design for).
 const MAX_TEXTURE_SIZE: u32 = 16384;
+/// Texel bytes all textures together may take when the device's limit is not known: one texture of the
+/// largest size (textures live in one storage buffer, 4 bytes per texel).
+const DEFAULT_TEXEL_BYTES: u64 = 4 * (MAX_TEXTURE_SIZE as u64) * (MAX_TEXTURE_SIZE as u64);
 /// Largest accessor element count; rejects absurd counts before anything is allocated.
 const MAX_ELEMENTS: u64 = 1 << 26;
 /// Deepest node hierarchy we follow (bounds the recursion).
@@ -58,16 +61,19 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
 }
 
 fn load_inner(path: &Path, options: &LoadOptions) -> Res<Scene> {
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    let bytes = crate::input_file::read_bounded(path, crate::input_file::MAX_GLTF_BYTES)?;
     let (json_bytes, bin) = split_container(path, &bytes)?;
     let is_glb = bytes.starts_with(b"glTF");
     let root = parse_json(json_bytes)?;
     let mut notes = Notes::default();
     check_extensions(&root, &mut notes)?;
     check_node_graph(&root)?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(&root, bin, is_glb, base)?;
-    let mut loader = Loader::new(&root, base, buffers, notes);
+    // A bare file name's parent is "": URIs are then relative to the working directory.
+    let base = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let uris = Uris { base, allow_outside: options.allow_outside_paths };
+    let buffers = load_buffers(&root, bin, is_glb, uris)?;
+    let mut loader = Loader::new(&root, uris, buffers, notes);
+    loader.texel_limit = options.max_texel_bytes.unwrap_or(DEFAULT_TEXEL_BYTES);
     loader.scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let roots = loader.scene_roots(options)?;
     let mut on_path = vec![false; root.nodes.len()];
@@ -84,7 +90,10 @@ fn quoted(name: &Option<String>) -> String {
 
 struct Loader<'a> {
     root: &'a json::Root,
-    base: &'a Path,
+    uris: Uris<'a>,
+    /// Bytes of RGBA8 texels the textures may take, and have taken (checked before each image is decoded).
+    texel_limit: u64,
+    texel_used: u64,
     buffers: Vec<Vec<u8>>,
     notes: Notes,
     scene: Scene,
@@ -96,10 +105,12 @@ struct Loader<'a> {
 }
 
 impl<'a> Loader<'a> {
-    fn new(root: &'a json::Root, base: &'a Path, buffers: Vec<Vec<u8>>, notes: Notes) -> Self {
+    fn new(root: &'a json::Root, uris: Uris<'a>, buffers: Vec<Vec<u8>>, notes: Notes) -> Self {
         Loader {
             root,
-            base,
+            uris,
+            texel_limit: DEFAULT_TEXEL_BYTES,
+            texel_used: 0,
             buffers,
             notes,
             scene: Scene::default(),
@@ -109,6 +120,10 @@ impl<'a> Loader<'a> {
             images: HashMap::new(),
             visits: 0,
         }
+    }
+
+    fn uris(&self) -> Uris<'a> {
+        self.uris
     }
 
     /// The finished scene: camera (from the file or framing the bounds) and warnings.

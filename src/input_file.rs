@@ -1,0 +1,173 @@
+//! Opening input files safely: every loader (scene files, glTF buffers and images, environment maps, TOML
+//! includes, and the importers that come later) reads through here, so a FIFO, a device such as `/dev/zero`,
+//! a directory or a symlink loop is a clear error instead of a hang or an unbounded read.
+//!
+//! The rules: an input is opened only if it is a regular file after following symlinks (checked before the
+//! open, and again on the open descriptor, which is opened non-blocking so a FIFO swapped in between cannot
+//! block); it is read up to a limit, documented per kind of input below, and never past it even if the file
+//! grows (or lies about its size, as `/proc` files do) while it is read.
+//!
+//! Errors are the problem alone ("is a FIFO (named pipe), not a regular file"); the caller names the file,
+//! and no error ever quotes the file's content.
+
+use std::fs::File;
+use std::io::Read;
+use std::path::Path;
+
+const MIB: u64 = 1 << 20;
+/// TOML scene files: text written by hand or by scripts; far larger is a mistake (or an attack).
+pub const MAX_TOML_BYTES: u64 = 64 * MIB;
+/// `.gltf` / `.glb` files and glTF buffers: meshes of tens of millions of triangles fit.
+pub const MAX_GLTF_BYTES: u64 = 2048 * MIB;
+/// Encoded images (glTF textures): a 16384² texture compresses to well under this.
+pub const MAX_IMAGE_BYTES: u64 = 512 * MIB;
+/// Environment maps (.hdr / .exr): a 16k × 8k float RGB EXR is 1.5 GiB uncompressed.
+pub const MAX_ENVMAP_BYTES: u64 = 2048 * MIB;
+
+/// Human size for messages: "12.0 MiB (12582912 bytes)".
+fn size(bytes: u64) -> String {
+    format!("{:.1} MiB ({bytes} bytes)", bytes as f64 / MIB as f64)
+}
+
+/// What a non-regular file is, for the message.
+fn kind_of(ft: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if ft.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if ft.is_char_device() {
+            return "a character device";
+        }
+        if ft.is_block_device() {
+            return "a block device";
+        }
+        if ft.is_socket() {
+            return "a socket";
+        }
+    }
+    if ft.is_dir() {
+        "a directory"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// The message for an I/O error on opening or inspecting `path`.
+fn describe_io(path: &Path, e: &std::io::Error) -> String {
+    // ELOOP: a symlink cycle (or a chain longer than the system follows).
+    #[cfg(target_os = "linux")]
+    if e.raw_os_error() == Some(40) {
+        return "is a symbolic link loop (too many levels of symbolic links)".into();
+    }
+    match e.kind() {
+        std::io::ErrorKind::NotFound if path.symlink_metadata().is_ok() => {
+            "is a symbolic link to a file that does not exist".into()
+        }
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => format!("cannot be read: {e}"),
+    }
+}
+
+/// Opens `path` for reading if it is a regular file (after following symlinks); returns it and its size.
+pub fn open_regular(path: &Path) -> Result<(File, u64), String> {
+    let meta = std::fs::metadata(path).map_err(|e| describe_io(path, &e))?;
+    let via_link = path.symlink_metadata().is_ok_and(|m| m.file_type().is_symlink());
+    let not_regular = |ft: &std::fs::FileType| {
+        let link = if via_link { " (through a symbolic link)" } else { "" };
+        format!("is {}{link}, not a regular file", kind_of(ft))
+    };
+    if !meta.is_file() {
+        return Err(not_regular(&meta.file_type()));
+    }
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // Non-blocking: a FIFO put in the file's place after the check above must not block the open.
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path).map_err(|e| describe_io(path, &e))?;
+    let meta = file.metadata().map_err(|e| describe_io(path, &e))?;
+    if !meta.is_file() {
+        return Err(not_regular(&meta.file_type()));
+    }
+    Ok((file, meta.len()))
+}
+
+/// Reads a whole regular file of at most `limit` bytes (see `open_regular`), refusing larger ones before
+/// reading them and never reading more than `limit` bytes however the file changes meanwhile.
+pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+    let (file, len) = open_regular(path)?;
+    let over = |n: u64| format!("is {}, over the limit of {} for this kind of input", size(n), size(limit));
+    if len > limit {
+        return Err(over(len));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| format!("cannot be read: {e}"))?;
+    if bytes.len() as u64 > limit {
+        return Err(over(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// The first `max` bytes of a regular file (all of it when shorter): for inputs that declare their own
+/// length, such as glTF buffers, which may be followed by more data that is not read.
+pub fn read_prefix(path: &Path, max: u64) -> Result<Vec<u8>, String> {
+    let (file, len) = open_regular(path)?;
+    let mut bytes = Vec::with_capacity(len.min(max) as usize);
+    file.take(max).read_to_end(&mut bytes).map_err(|e| format!("cannot be read: {e}"))?;
+    Ok(bytes)
+}
+
+/// `read_bounded` for UTF-8 text.
+pub fn read_bounded_text(path: &Path, limit: u64) -> Result<String, String> {
+    let bytes = read_bounded(path, limit)?;
+    String::from_utf8(bytes)
+        .map_err(|e| format!("is not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()))
+}
+
+/// Cuts text echoed from an input (a key, a name, a URI) to at most `max` characters, marking the cut.
+pub fn clip(text: &str, max: usize) -> String {
+    if text.chars().count() <= max {
+        return text.to_string();
+    }
+    let kept: String = text.chars().take(max).collect();
+    format!("{kept}… ({} characters)", text.chars().count())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_what_is_not_a_regular_file() {
+        let e = read_bounded(Path::new("/dev/zero"), 1 << 20).unwrap_err();
+        assert!(e.contains("character device"), "{e}");
+        let e = read_bounded(Path::new("/"), 1 << 20).unwrap_err();
+        assert!(e.contains("a directory"), "{e}");
+        let e = read_bounded(Path::new("/no/such/file"), 1 << 20).unwrap_err();
+        assert_eq!(e, "no such file");
+    }
+
+    #[test]
+    fn limit_is_enforced_and_content_never_echoed() {
+        let dir = std::env::temp_dir().join(format!("mislab-input-file-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("ten.bin");
+        std::fs::write(&p, b"secretsecr").unwrap();
+        assert_eq!(read_bounded(&p, 10).unwrap().len(), 10);
+        let e = read_bounded(&p, 9).unwrap_err();
+        assert!(e.contains("over the limit") && !e.contains("secret"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn clip_marks_the_cut() {
+        assert_eq!(clip("abc", 3), "abc");
+        assert_eq!(clip("abcdef", 3), "abc… (6 characters)");
+    }
+}
