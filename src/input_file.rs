@@ -148,7 +148,7 @@ pub fn clip_quoted(message: &str, max: usize) -> String {
             out.push('`');
         }
         // Odd parts lie between backticks.
-        out.push_str(&if i % 2 == 1 { clip(part, max) } else { clip(part, 4 * max) });
+        out.push_str(&if i % 2 == 1 { clip(part, max) } else { clip(part, 400) });
     }
     out
 }
