@@ -139,6 +139,20 @@ pub fn clip(text: &str, max: usize) -> String {
     format!("{kept}… ({} characters)", text.chars().count())
 }
 
+/// A parser's message with every `backtick-quoted` span (where parsers echo keys and values) cut to `max`
+/// characters: a 10 MB key is not echoed in full.
+pub fn clip_quoted(message: &str, max: usize) -> String {
+    let mut out = String::with_capacity(message.len().min(4096));
+    for (i, part) in message.split('`').enumerate() {
+        if i > 0 {
+            out.push('`');
+        }
+        // Odd parts lie between backticks.
+        out.push_str(&if i % 2 == 1 { clip(part, max) } else { clip(part, 400) });
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,5 +183,9 @@ mod tests {
     fn clip_marks_the_cut() {
         assert_eq!(clip("abc", 3), "abc");
         assert_eq!(clip("abcdef", 3), "abc… (6 characters)");
+        assert_eq!(
+            clip_quoted("unknown field `abcdef`, expected `x`", 3),
+            "unknown field `abc… (6 characters)`, expected `x`"
+        );
     }
 }

@@ -183,6 +183,11 @@ fn check(case: &Case, scratch: &Path) -> Result<f64, String> {
             if !leftovers.is_empty() {
                 problems.push(format!("failed but left files where the image would go: {leftovers:?}"));
             }
+            // Echoed input is cut (a 100 000-character key or URI must not come back in full).
+            if let Some(long) = err.lines().find(|l| l.chars().count() > 1000) {
+                problems
+                    .push(format!("a stderr line of {} characters (echoed input is not cut)", long.chars().count()));
+            }
         }
         Expect::Warning | Expect::Ok => {
             if o.code != Some(0) {
@@ -347,4 +352,159 @@ fn binding_size_check_names_the_buffer_and_the_limit() {
     let data = SceneData { tri_verts: vec![[0.0; 4]; 3 * 30_000], ..Default::default() };
     let e = check_binding_sizes(&data, limit).unwrap_err();
     assert!(e.contains("triangle vertices") && e.contains("1440000 bytes"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Special files (which git cannot hold): FIFOs, /dev/zero, directories, symlink loops, as every kind of input
+
+/// One special-file case: the arguments after `mislab render`, the file the error must name, and what it says.
+struct Special {
+    args: Vec<String>,
+    names: &'static str,
+    says: &'static str,
+}
+
+fn special(args: &[&str], names: &'static str, says: &'static str) -> Special {
+    Special { args: args.iter().map(|a| a.to_string()).collect(), names, says }
+}
+
+#[cfg(unix)]
+#[test]
+fn special_files_are_clear_errors_not_hangs() {
+    use std::os::unix::fs::symlink;
+    let dir = std::env::temp_dir().join(format!("mislab-special-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("dir.gltf")).unwrap();
+    for fifo in ["fifo.gltf", "fifo.glb", "fifo.toml", "fifo.hdr", "fifo.bin", "fifo.png"] {
+        let status = Command::new("mkfifo").arg(dir.join(fifo)).status().expect("run mkfifo");
+        assert!(status.success(), "mkfifo {fifo}");
+    }
+    for link in ["zero.gltf", "zero.glb", "zero.toml", "zero.hdr", "zero.exr", "zero.bin"] {
+        symlink("/dev/zero", dir.join(link)).unwrap();
+    }
+    symlink("loop-b.gltf", dir.join("loop-a.gltf")).unwrap();
+    symlink("loop-a.gltf", dir.join("loop-b.gltf")).unwrap();
+    symlink("missing.gltf", dir.join("dangling.gltf")).unwrap();
+    let tri = |uri: &str, image: Option<&str>| {
+        let images =
+            image.map(|i| format!(r#","textures":[{{"source":0}}],"images":[{{"uri":"{i}"}}]"#)).unwrap_or_default();
+        let material = if image.is_some() { r#","pbrMetallicRoughness":{"baseColorTexture":{"index":0}}"# } else { "" };
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scenes":[{{"nodes":[0]}}],"scene":0,"nodes":[{{"mesh":0}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],
+            "materials":[{{"emissiveFactor":[1,1,1]{material}}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],"buffers":[{{"byteLength":36,"uri":"{uri}"}}]{images}}}"#
+        )
+    };
+    let embedded = "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA";
+    std::fs::write(dir.join("buffer-fifo.gltf"), tri("fifo.bin", None)).unwrap();
+    std::fs::write(dir.join("buffer-zero.gltf"), tri("zero.bin", None)).unwrap();
+    std::fs::write(dir.join("buffer-dir.gltf"), tri("dir.gltf", None)).unwrap();
+    std::fs::write(dir.join("image-fifo.gltf"), tri(embedded, Some("fifo.png"))).unwrap();
+    std::fs::write(dir.join("image-zero.gltf"), tri(embedded, Some("zero.png"))).unwrap();
+    symlink("/dev/zero", dir.join("zero.png")).unwrap();
+    let toml = |body: &str| format!("[camera]\nposition = [0, 0, 5]\n{body}");
+    std::fs::write(dir.join("env-fifo.toml"), toml("[environment]\nmap = \"fifo.hdr\"\n")).unwrap();
+    std::fs::write(dir.join("env-zero.toml"), toml("[environment]\nmap = \"zero.exr\"\n")).unwrap();
+    std::fs::write(dir.join("include-fifo.toml"), toml("[[include]]\ngltf = \"fifo.gltf\"\n")).unwrap();
+    std::fs::write(dir.join("include-zero.toml"), toml("[[include]]\ngltf = \"zero.gltf\"\n")).unwrap();
+    std::fs::write(dir.join("include-dir.toml"), toml("[[include]]\ngltf = \"dir.gltf\"\n")).unwrap();
+
+    let fifo = "is a FIFO (named pipe), not a regular file";
+    let zero = "is a character device (through a symbolic link), not a regular file";
+    let cases = [
+        special(&["fifo.gltf"], "fifo.gltf", fifo),
+        special(&["fifo.glb"], "fifo.glb", fifo),
+        special(&["fifo.toml"], "fifo.toml", fifo),
+        special(&["zero.gltf"], "zero.gltf", zero),
+        special(&["zero.glb"], "zero.glb", zero),
+        special(&["zero.toml"], "zero.toml", zero),
+        special(&["dir.gltf"], "dir.gltf", "is a directory, not a regular file"),
+        special(&["loop-a.gltf"], "loop-a.gltf", "is a symbolic link loop"),
+        special(&["dangling.gltf"], "dangling.gltf", "is a symbolic link to a file that does not exist"),
+        special(&["furnace", "--env", "fifo.hdr"], "fifo.hdr", fifo),
+        special(&["furnace", "--env", "zero.hdr"], "zero.hdr", zero),
+        special(&["furnace", "--env", "zero.exr"], "zero.exr", zero),
+        special(&["buffer-fifo.gltf"], "buffer-fifo.gltf", fifo),
+        special(&["buffer-dir.gltf"], "buffer-dir.gltf", "is a directory"),
+        // A symlink out of the asset's directory is refused as such; allowed, it is still not a regular file.
+        special(
+            &["buffer-zero.gltf"],
+            "buffer-zero.gltf",
+            "leads outside the glTF file's directory through a symbolic link",
+        ),
+        special(&["buffer-zero.gltf", "--allow-outside-paths"], "buffer-zero.gltf", zero),
+        special(&["image-fifo.gltf"], "image-fifo.gltf", fifo),
+        special(&["image-zero.gltf", "--allow-outside-paths"], "image-zero.gltf", zero),
+        special(&["env-fifo.toml"], "env-fifo.toml", fifo),
+        special(&["env-zero.toml"], "env-zero.toml", zero),
+        special(&["include-fifo.toml"], "include-fifo.toml", fifo),
+        special(&["include-zero.toml"], "include-zero.toml", zero),
+        special(&["include-dir.toml"], "include-dir.toml", "is a directory"),
+    ];
+    let start = Instant::now();
+    let mut failures = Vec::new();
+    for c in &cases {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_mislab"));
+        cmd.current_dir(&dir).arg("render").args(&c.args).arg("-o").arg(dir.join("out.png"));
+        cmd.args(["--spp", "1", "--width", "16", "--height", "16"]);
+        match run(cmd) {
+            Err(e) => failures.push(format!("{:?}: {e}", c.args)),
+            Ok(o) => {
+                let line =
+                    o.stderr.lines().find(|l| l.starts_with("error:") && l.contains(c.names) && l.contains(c.says));
+                if o.code != Some(2) || line.is_none() || dir.join("out.png").exists() {
+                    failures.push(format!(
+                        "{:?}: exit {:?}, expected 2 and an error naming {} that says {:?}:\n{}",
+                        c.args,
+                        o.code,
+                        c.names,
+                        c.says,
+                        o.stderr.trim_end()
+                    ));
+                }
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    println!("{} special-file cases in {:.1} s", cases.len(), start.elapsed().as_secs_f64());
+    assert!(failures.is_empty(), "{} of {} cases failed:\n\n{}", failures.len(), cases.len(), failures.join("\n\n"));
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Numeric flags: refused like their TOML twins, at parse time (exit 2, the flag named), before any work
+
+#[test]
+fn numeric_flags_are_validated_like_their_toml_twins() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["--exposure", "nan"], "--exposure"),
+        (&["--exposure", "inf"], "--exposure"),
+        (&["--exposure", "128"], "--exposure"),
+        (&["--env-scale", "inf"], "--env-scale"),
+        (&["--env-scale", "nan"], "--env-scale"),
+        (&["--env-scale", "-1"], "--env-scale"),
+        (&["--env-scale", "1e39"], "--env-scale"),
+        (&["--env-rotation", "nan"], "--env-rotation"),
+        (&["--time", "nan"], "--time"),
+        (&["--time", "0"], "--time"),
+        (&["--spp", "0"], "an integer from 1 to 4294967295"),
+        (&["--spp", "4294967296"], "an integer from 1 to 4294967295"),
+        (&["--seed", "4294967296"], "--seed"),
+        (&["-o", "/nonexistent-dir/x.png"], "the output directory /nonexistent-dir does not exist"),
+        (&["-o", "/"], "/"),
+    ];
+    let mut failures = Vec::new();
+    for (args, says) in cases {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_mislab"));
+        cmd.args(["render", "furnace", "--width", "8", "--height", "8"]).args(*args);
+        let o = run(cmd).unwrap_or_else(|e| panic!("{args:?}: {e}"));
+        let line = o.stderr.lines().find(|l| l.starts_with("error:") && l.contains(says));
+        // Refused before start-up: nothing was loaded or compiled.
+        if o.code != Some(2) || line.is_none() || o.stderr.contains("start-up") {
+            failures
+                .push(format!("{args:?}: exit {:?}, expected 2 and an error saying {says:?}:\n{}", o.code, o.stderr));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }

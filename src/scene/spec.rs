@@ -18,7 +18,7 @@ pub struct SceneSpec {
     #[arg(long)]
     pub env: Option<PathBuf>,
     /// Scale of the --env map (finite, 0 to 1e30).
-    #[arg(long, default_value_t = 1.0, value_parser = crate::cli_values::env_scale)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = crate::cli_values::env_scale)]
     pub env_scale: f32,
     /// Rotation of the --env map about +Y, degrees.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::cli_values::degrees)]

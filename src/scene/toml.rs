@@ -23,7 +23,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     let file: FileDef = ::toml::from_str(&text).map_err(|e| {
         let at = e.span().map(|s| ctx.position(s.start)).unwrap_or_default();
         // toml's messages can span lines ("invalid table header\nexpected `.`, `]`"); keep ours on one.
-        let message = e.message().trim_end().replace('\n', "; ");
+        let message = crate::input_file::clip_quoted(&e.message().trim_end().replace('\n', "; "), 80);
         SceneError::new(path, format!("{at}{message}"))
     })?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());

@@ -36,7 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 OWNED = [
     "aux", "gltf", "glb", "texture", "toml", "env",
     "gen-glb-trunc", "gen-gltf-trunc", "gen-bin-trunc", "gen-png-trunc", "gen-hdr-trunc", "gen-exr-trunc",
-    "gen-glb-garble", "gen-gltf-garble", "gen-hdr-garble", "gen-exr-garble", "gen-magic",
+    "gen-glb-garble", "gen-gltf-garble", "gen-hdr-garble", "gen-exr-garble", "gen-magic", "hostile",
 ]
 MANIFEST = []
 for _d in OWNED:
@@ -60,6 +60,11 @@ def case(rel, data, expect, substring="", mode=None, args=""):
     assert rel not in [m[0] for m in MANIFEST], rel
     if mode is None:
         mode = "env" if rel.lower().endswith((".hdr", ".exr")) else "scene"
+    text = data if isinstance(data, str) else data.decode("utf-8", "replace")
+    if rel.endswith(".gltf") and '"../aux' in text and "--allow-outside-paths" not in args:
+        # These cases test something else and reach aux/ by design: glTF URIs that leave the file's
+        # directory are refused without the flag (section 6 tests that).
+        args = (args + " --allow-outside-paths").strip()
     write(rel, data)
     MANIFEST.append((rel, mode, expect, substring, args))
 
@@ -1057,6 +1062,59 @@ for i, magic in enumerate([b"{lTF", b" {lT"]):
     data = magic + CUBE_GLB[4:]
     case(f"gen-magic/json-like-{i:02d}.glb", data, "error", "invalid glTF JSON")
 case("gen-magic/glb-bytes-in-gltf.gltf", patch(CUBE_GLB, 0, b"glTf"), "error", "invalid glTF JSON")
+
+# =========================================================================================================
+# 6. Hostile inputs (issue 17): indices of 2^32 and more (which gltf-json wraps), URIs that leave the asset's
+# directory, declared sizes far beyond any limit, and echoed input that must be cut. Special files (FIFOs,
+# /dev/zero, symlink loops) cannot live in git: tests/bad_input.rs makes them at run time.
+
+def h(name, edit, expect, substring="", args="", base=None):
+    doc = edited(base() if base else tri(), edit)
+    case(f"hostile/{name}.gltf", to_json(doc), expect, substring, args=args)
+
+
+W = 2 ** 32
+h("index-wrap-mesh", set_(["nodes", 0, "mesh"], W), "error", "nodes[0].mesh: index 4294967296 does not exist")
+h("index-wrap-mesh-plus-5", set_(["nodes", 0, "mesh"], W + 5), "error", "nodes[0].mesh: index 4294967301 does not exist")
+h("index-wrap-child", set_(["nodes", 0, "children"], [W + 1]), "error", "nodes[0].children[0]: index 4294967297 does not exist")
+h("index-wrap-position", set_(ATTR + ["POSITION"], W), "error", "attributes.POSITION: index 4294967296 does not exist")
+h("index-wrap-normal", set_(ATTR + ["NORMAL"], W + 2), "error", "attributes.NORMAL: index 4294967298 does not exist")
+h("index-wrap-indices", set_(PRIM + ["indices"], W + 1), "error", "primitives[0].indices: index 4294967297 does not exist")
+h("index-wrap-material", set_(PRIM + ["material"], W), "error", "primitives[0].material: index 4294967296 does not exist")
+h("index-wrap-default-scene", set_(["scene"], W), "error", "scene: index 4294967296 does not exist")
+h("index-wrap-scene-node", set_(["scenes", 0, "nodes"], [W]), "error", "scenes[0].nodes[0]: index 4294967296 does not exist")
+h("index-wrap-bufferview", set_(["accessors", 0, "bufferView"], W), "error", "accessors[0].bufferView: index 4294967296")
+h("index-wrap-buffer", set_(["bufferViews", 0, "buffer"], W), "error", "bufferViews[0].buffer: index 4294967296")
+h("index-wrap-2-pow-53", set_(["nodes", 0, "mesh"], 2 ** 53), "error", "index 9007199254740992 does not exist")
+h("index-wrap-u64-max", set_(["nodes", 0, "mesh"], 2 ** 64 - 1), "error", "index 18446744073709551615 does not exist")
+h("index-wrap-texture", lambda d: d.update(edited(textured(b64uri(png(8, 8))), set_(["materials", 0, "pbrMetallicRoughness",
+  "baseColorTexture", "index"], W))), "error", "baseColorTexture.index: index 4294967296 does not exist")
+h("index-wrap-image-source", lambda d: d.update(edited(textured(b64uri(png(8, 8))), set_(["textures", 0, "source"], W))),
+  "error", "textures[0].source: index 4294967296 does not exist")
+h("index-in-extras-is-data", set_(["nodes", 0, "extras"], {"mesh": W}), "ok")
+# Declared sizes: refused before anything is read or allocated.
+h("buffer-bytelength-2-pow-53", set_(["buffers", 0, "byteLength"], 2 ** 53), "error",
+  "buffer 0: byteLength 9007199254740992 exceeds the limit")
+h("buffer-bytelength-2-pow-53-external", lambda d: d["buffers"][0].update(uri="tri.bin", byteLength=2 ** 53), "error",
+  "buffer 0: byteLength 9007199254740992 exceeds the limit")
+# URIs: absolute, climbing with ../ or %2e%2e, refused (resolved against the glTF file's directory).
+h("uri-absolute", set_(["buffers", 0, "uri"], "/etc/passwd"), "error", "buffer 0: URI '/etc/passwd' is an absolute path")
+h("uri-absolute-missing", set_(["buffers", 0, "uri"], "/nonexistent/mislab.bin"), "error", "is an absolute path")
+h("uri-parent", set_(["buffers", 0, "uri"], "../../../../../../../../etc/passwd"), "error",
+  "leads outside the glTF file's directory")
+h("uri-parent-percent", set_(["buffers", 0, "uri"], "%2e%2e/%2e%2e/%2e%2e/%2e%2e/%2e%2e/etc/passwd"), "error",
+  "leads outside the glTF file's directory")
+h("uri-parent-after-descent", set_(["buffers", 0, "uri"], "a/../../aux/tri.bin"), "error", "leads outside the glTF file's directory")
+h("uri-parent-allowed", lambda d: d["buffers"][0].update(uri="../aux/tri.bin", byteLength=80), "ok", args="--allow-outside-paths")
+h("uri-image-absolute", lambda d: d.update(textured("/etc/passwd")), "error", "image 0 (/etc/passwd): URI '/etc/passwd' is an absolute path")
+h("uri-image-parent", lambda d: d.update(textured("../../../../../../etc/passwd")), "error", "leads outside the glTF file's directory")
+h("uri-image-percent", lambda d: d.update(textured("%2E%2E/%2E%2E/%2E%2E/%2E%2E/etc/passwd")), "error", "leads outside")
+# Echoed input is cut: a URI of 100 000 characters is quoted as its first 80 and its length.
+h("uri-long", set_(["buffers", 0, "uri"], "x" * 100000 + ".bin"), "error", "characters)': cannot be read")
+h("uri-long-scheme", set_(["buffers", 0, "uri"], "http://" + "y" * 100000), "error", "… (100007 characters)")
+case("hostile/no-extension", to_json(tri()), "error", "has no file extension")
+case("hostile/extension-long." + "z" * 200, to_json(tri()), "error", "unknown scene format")
+case("hostile/unknown-key-long.toml", "k" * 100000 + " = 1\n" + VALID_TOML, "error", "characters)")
 
 # =========================================================================================================
 # The manifest
