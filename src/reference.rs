@@ -95,7 +95,16 @@ pub fn render_reference(
     budget: Budget,
     dispatch_spp: u32,
 ) -> Result<(Film, RenderStats), String> {
-    render_reference_from(ctx, SceneData::build(scene), scene, settings, budget, dispatch_spp, 0, &AtomicBool::new(false))
+    render_reference_from(
+        ctx,
+        SceneData::build(scene),
+        scene,
+        settings,
+        budget,
+        dispatch_spp,
+        0,
+        &AtomicBool::new(false),
+    )
 }
 
 /// `render_reference` of the sample indices from `first` on (`--part`: `state::session::part_range`), with the

@@ -4,15 +4,13 @@
 use super::SceneError;
 use std::path::Path;
 
-/// Reads `path` whole. `referenced_by` (e.g. `scene.pbrt: line 12`) is added to the error message.
+/// Reads `path` whole, if it is a regular file (after symlinks; a FIFO or device never blocks or floods it) of at
+/// most `input_file::MAX_GLTF_BYTES` (scene text, meshes and images alike). `referenced_by` (e.g.
+/// `scene.pbrt: line 12`) is added to the error message.
 pub fn read_bytes(path: &Path, referenced_by: &str) -> Result<Vec<u8>, SceneError> {
     let by = if referenced_by.is_empty() { String::new() } else { format!(" (referenced by {referenced_by})") };
-    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => SceneError::new(path, format!("file not found{by}")),
-        _ => SceneError::new(path, format!("cannot read: {e}{by}")),
-    })?;
-    if !meta.is_file() {
-        return Err(SceneError::new(path, format!("not a regular file{by}")));
-    }
-    std::fs::read(path).map_err(|e| SceneError::new(path, format!("cannot read: {e}{by}")))
+    crate::input_file::read_bounded(path, crate::input_file::MAX_GLTF_BYTES).map_err(|e| {
+        let e = if e == "no such file" { "file not found".to_string() } else { e };
+        SceneError::new(path, format!("{e}{by}"))
+    })
 }
