@@ -672,7 +672,8 @@ fn include(
     let path = ctx.resolve(&d.gltf);
     // The same check every input gets (a FIFO, a directory or /dev/zero is named as what it is).
     if let Err(m) = crate::input_file::open_regular(&path) {
-        return Err(e(&format!("glTF file {} {m}", path.display())));
+        let m = if m == "no such file" { "not found".to_string() } else { m };
+        return Err(e(&format!("glTF file {}: {m}", path.display())));
     }
     // The include's own `scene` (not the command line's --gltf-scene, which is for a top-level glTF file).
     let mut options = options.clone();
