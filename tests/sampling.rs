@@ -1327,6 +1327,23 @@ fn chi2_environment() {
 // ---------------------------------------------------------------------------------------------------------------
 // Light selection
 
+/// N light selections of `s` (an R_SELECT setup) with `seed`: how often each of the `n_lights` was picked, the
+/// device's pmf function of each, and the largest relative difference between the pmf a pick returned and that
+/// function at its index (0: sampling and evaluation agree bit for bit).
+fn selection_histogram(s: &Setup, n_lights: usize, seed: u32) -> (Vec<u64>, Vec<f64>, f64) {
+    let h = harness();
+    let out = h.sample(s, N, 0, 1, seed);
+    let mut counts = vec![0u64; n_lights];
+    for [a, _] in &out {
+        counts[a[0] as usize] += 1;
+    }
+    let pts: Vec<[[f32; 4]; 2]> = (0..n_lights).map(|i| [[i as f32, 0.0, 0.0, 0.0], [0.0; 4]]).collect();
+    let pmf = h.pdf(s, &pts);
+    let mismatch =
+        out.iter().map(|[a, _]| ((a[1] as f64 - pmf[a[0] as usize]) / pmf[a[0] as usize]).abs()).fold(0.0, f64::max);
+    (counts, pmf, mismatch)
+}
+
 #[test]
 fn chi2_light_selection() {
     let h = harness();
@@ -1336,18 +1353,8 @@ fn chi2_light_selection() {
         let mut s = Setup::new(SceneId::Lights, R_SELECT);
         s.frame.light_select = select.tag();
         let t0 = std::time::Instant::now();
-        let out = h.sample(&s, N, 0, 1, 77 + select.tag());
-        let mut counts = vec![0u64; n_lights];
-        for [a, _] in &out {
-            counts[a[0] as usize] += 1;
-        }
-        let pts: Vec<[[f32; 4]; 2]> = (0..n_lights).map(|i| [[i as f32, 0.0, 0.0, 0.0], [0.0; 4]]).collect();
-        let pmf = h.pdf(&s, &pts);
         // The pmf the selection returned with each sample is light_pmf of that index.
-        let mismatch = out
-            .iter()
-            .map(|[a, _]| ((a[1] as f64 - pmf[a[0] as usize]) / pmf[a[0] as usize]).abs())
-            .fold(0.0, f64::max);
+        let (counts, pmf, mismatch) = selection_histogram(&s, n_lights, 77 + select.tag());
         let report = chi2::discrete_test(&format!("light selection ({select})"), &counts, &pmf, alpha());
         eprintln!("{}  [pmf {:?}]", report.summary(), pmf.iter().map(|p| format!("{p:.4}")).collect::<Vec<_>>());
         rows.push(Row {
@@ -1394,17 +1401,7 @@ fn chi2_light_tree_selection() {
         s.job.p = [p[0], p[1], p[2], 0.0];
         s.job.a = [n[0], n[1], n[2], 0.0];
         let t0 = std::time::Instant::now();
-        let out = h.sample(&s, N, 0, 1, 311 + k as u32);
-        let mut counts = vec![0u64; n_lights];
-        for [a, _] in &out {
-            counts[a[0] as usize] += 1;
-        }
-        let pts: Vec<[[f32; 4]; 2]> = (0..n_lights).map(|i| [[i as f32, 0.0, 0.0, 0.0], [0.0; 4]]).collect();
-        let pmf = h.pdf(&s, &pts);
-        let mismatch = out
-            .iter()
-            .map(|[a, _]| ((a[1] as f64 - pmf[a[0] as usize]) / pmf[a[0] as usize]).abs())
-            .fold(0.0, f64::max);
+        let (counts, pmf, mismatch) = selection_histogram(&s, n_lights, 311 + k as u32);
         let sum: f64 = pmf.iter().sum();
         if (sum - 1.0).abs() > 1e-5 {
             failures.push(format!("{name}: Σ pmf = {sum}"));
