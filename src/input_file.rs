@@ -139,6 +139,18 @@ pub fn clip(text: &str, max: usize) -> String {
     format!("{kept}… ({} characters)", text.chars().count())
 }
 
+/// A path echoed in a message, cut to its last `max` characters when longer: the file name at the end
+/// is what tells the user which file it is.
+pub fn clip_path(path: &Path, max: usize) -> String {
+    let text = path.display().to_string();
+    let n = text.chars().count();
+    if n <= max {
+        return text;
+    }
+    let kept: String = text.chars().skip(n - max).collect();
+    format!("…{kept} ({n} characters)")
+}
+
 /// A parser's message with every `backtick-quoted` span (where parsers echo keys and values) cut to `max`
 /// characters: a 10 MB key is not echoed in full.
 pub fn clip_quoted(message: &str, max: usize) -> String {
@@ -187,5 +199,7 @@ mod tests {
             clip_quoted("unknown field `abcdef`, expected `x`", 3),
             "unknown field `abc… (6 characters)`, expected `x`"
         );
+        assert_eq!(clip_path(Path::new("/a/b/file.bin"), 8), "…file.bin (13 characters)");
+        assert_eq!(clip_path(Path::new("/a/file.bin"), 80), "/a/file.bin");
     }
 }

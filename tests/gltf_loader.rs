@@ -549,6 +549,20 @@ fn robustness_corpus() {
     }
 }
 
+/// A missing buffer's message keeps the file name however long the directory path is (CI's checkout lies
+/// deeper than a developer's).
+#[test]
+fn missing_buffer_named_under_a_long_path() {
+    let deep =
+        std::env::temp_dir().join(format!("mislab-{}-{}", std::process::id(), "d".repeat(120))).join("e".repeat(100));
+    std::fs::create_dir_all(&deep).unwrap();
+    let gltf = deep.join("BoxTextured.gltf");
+    std::fs::copy(format!("{TESTDATA}/robustness/assimp/MissingBin/BoxTextured.gltf"), &gltf).unwrap();
+    let e = load_no_panic(&gltf).unwrap_err();
+    std::fs::remove_dir_all(deep.parent().unwrap()).unwrap();
+    assert!(e.contains("BoxTextured0.bin") && e.contains("no such file"), "{e}");
+}
+
 #[test]
 fn repaired_content_of_the_robustness_files() {
     let bad_normals = load_ok(&format!("{TESTDATA}/robustness/assimp/BoxBadNormals-glTF-Binary/BoxBadNormals.glb"));

@@ -257,7 +257,7 @@ pub(super) fn fetch_uri(uris: Uris, uri: &str, read: impl Fn(&Path) -> Res<Vec<u
         }
         p => p,
     };
-    read(&path).map_err(|m| format!("cannot read '{}': {m}", shown(&path.display().to_string())))
+    read(&path).map_err(|m| format!("cannot read '{}': {m}", crate::input_file::clip_path(&path, 160)))
 }
 
 /// The file a relative URI names, refusing (unless allowed) absolute paths and paths that climb out of the
