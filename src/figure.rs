@@ -196,19 +196,18 @@ fn render(ctx: &GpuContext, renderer: &mut Renderer, spp: u32) -> Result<Film, S
 /// Writes a PNG through a temporary file and a rename (no truncated figure after an interruption); a figure
 /// whose every pixel is grey (both built-in figures) is stored as 8-bit greyscale, a third of the size.
 fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String> {
-    let tmp = path.with_extension("png.partial");
     let grey = img.pixels().all(|p| p.0[0] == p.0[1] && p.0[1] == p.0[2]);
-    let result = if grey {
-        image::GrayImage::from_fn(img.width(), img.height(), |x, y| image::Luma([img.get_pixel(x, y).0[0]]))
-            .save_with_format(&tmp, image::ImageFormat::Png)
-    } else {
-        img.save_with_format(&tmp, image::ImageFormat::Png)
+    let write = |tmp: &std::path::Path| {
+        let result = if grey {
+            image::GrayImage::from_fn(img.width(), img.height(), |x, y| image::Luma([img.get_pixel(x, y).0[0]]))
+                .save_with_format(tmp, image::ImageFormat::Png)
+        } else {
+            img.save_with_format(tmp, image::ImageFormat::Png)
+        };
+        result.map_err(|e| e.to_string())
     };
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: could not write the figure: {e}", path.display())
-    })?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: could not write the figure: {e}", path.display()))
+    crate::output_file::replace_atomically(path, write)
+        .map_err(|e| format!("{}: could not write the figure: {e}", path.display()))
 }
 
 /// Draws `text` (upper-cased; characters without a glyph become blanks) at (x, y) in white on a darkened box,

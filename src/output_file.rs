@@ -87,19 +87,32 @@ fn temp_path(file: &Path) -> PathBuf {
     parent_of(file).join(format!(".{name}.{}.partial", std::process::id()))
 }
 
+/// Replaces `file` by what `write` creates at a temporary path beside it: write, fsync the file, rename over
+/// `file`, fsync the directory (so the rename itself survives a crash). A kill or a full disk at any moment
+/// leaves the old file or the new one, never a torn one; a failed write leaves no temporary behind. The one
+/// way mislab writes its outputs (images, figures, state files).
+pub fn replace_atomically(file: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+    let tmp = temp_path(file);
+    let result = write(&tmp).and_then(|()| {
+        let synced = std::fs::OpenOptions::new().write(true).open(&tmp).and_then(|f| f.sync_all());
+        synced.and_then(|()| std::fs::rename(&tmp, file)).map_err(|e| e.to_string())?;
+        // Directories cannot be opened for syncing everywhere; the rename is done either way.
+        if let Ok(d) = std::fs::File::open(parent_of(file)) {
+            let _ = d.sync_all();
+        }
+        Ok(())
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
 impl OutputTarget {
     /// Writes the output through `write` (given the temporary path to create) and renames it into place.
     pub fn write(&self, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
-        let tmp = temp_path(&self.file);
-        let shown = self.given.display();
-        if let Err(e) = write(&tmp) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(format!("{shown}: could not write the image: {e}"));
-        }
-        std::fs::rename(&tmp, &self.file).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("{shown}: could not write the image: {e}")
-        })
+        replace_atomically(&self.file, write)
+            .map_err(|e| format!("{}: could not write the image: {e}", self.given.display()))
     }
 }
 

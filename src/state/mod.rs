@@ -8,7 +8,6 @@
 //! `{mean: [f32; 3], count: u32, m2: [f32; 3], nonfinite: u32}` (the WGSL `Accum`), then the FNV-1a 64 hash of
 //! every byte before it (a truncated or corrupted file is refused instead of resumed).
 
-pub mod atomic;
 pub mod merge;
 pub mod session;
 
@@ -299,6 +298,8 @@ impl RenderState {
 
     /// Writes the state atomically (temporary file, fsync, rename).
     pub fn write(&self, path: &Path) -> Result<(), String> {
-        atomic::write(path, &self.to_bytes())
+        let bytes = self.to_bytes();
+        crate::output_file::replace_atomically(path, |tmp| std::fs::write(tmp, &bytes).map_err(|e| e.to_string()))
+            .map_err(|e| format!("{}: could not write the state file: {e}", path.display()))
     }
 }
