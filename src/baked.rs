@@ -82,56 +82,31 @@ impl MeshTopology {
     }
 }
 
-/// WGSL member types of the baked structs, in order (their layouts match the Rust twins: tests/layout.rs).
-const SPHERE_MEMBERS: &[&str] = &["vec3<f32>", "f32", "u32", "u32", "u32", "u32"];
-const QUAD_MEMBERS: &[&str] = &["vec3<f32>", "u32", "vec3<f32>", "u32", "vec3<f32>", "u32"];
-const TRI_SHADING_MEMBERS: &[&str] =
-    &["vec3<f32>", "u32", "vec3<f32>", "u32", "vec3<f32>", "u32", "vec2<f32>", "vec2<f32>", "vec2<f32>", "vec2<u32>"];
-const MATERIAL_MEMBERS: &[&str] = &[
-    "vec3<f32>",
-    "f32",
-    "vec3<f32>",
-    "f32",
-    "f32",
-    "u32",
-    "u32",
-    "u32",
-    "vec4<f32>",
-    "vec4<f32>",
-    "vec4<f32>",
-    "vec4<f32>",
-    "vec4<f32>",
-    "vec4<f32>",
-    "vec3<f32>",
-    "u32",
-    "vec3<f32>",
-    "f32",
-];
-const LIGHT_MEMBERS: &[&str] = &[
-    "vec3<f32>",
-    "u32",
-    "vec3<f32>",
-    "u32",
-    "vec3<f32>",
-    "f32",
-    "f32",
-    "f32",
-    "f32",
-    "f32",
-    "u32",
-    "u32",
-    "u32",
-    "u32",
-];
+/// The member types of WGSL struct `name` in shaders/common.wgsl, in order, read from the shader source itself
+/// so that the literals written here can never fall out of step with the struct (whose layout matches its Rust
+/// twin: tests/layout.rs). One member per line, `name: type,` with an optional `//` comment, as common.wgsl
+/// writes them.
+fn wgsl_members(name: &str) -> Vec<String> {
+    let source = crate::shaders::file("common.wgsl");
+    let head = format!("struct {name} {{");
+    let body =
+        source.split_once(&head).map(|(_, rest)| rest).unwrap_or_else(|| panic!("no struct {name} in common.wgsl"));
+    let body = &body[..body.find('}').expect("struct body closed")];
+    body.lines()
+        .map(|l| l.split("//").next().unwrap_or("").trim())
+        .filter(|l| !l.is_empty())
+        .map(|l| l.split_once(':').expect("member `name: type,`").1.trim().trim_end_matches(',').trim().to_string())
+        .collect()
+}
 
 /// A WGSL constructor `name(...)` for one struct given as 4-byte words, or None if a float is not finite (WGSL
 /// has no literal for it; that table is then read from its buffer).
-fn struct_lit(name: &str, members: &[&str], words: &[u32]) -> Option<String> {
+fn struct_lit(name: &str, members: &[String], words: &[u32]) -> Option<String> {
     let mut args = vec![];
     let mut w = words.iter();
     for ty in members {
-        let (n, scalar) = match *ty {
-            "f32" | "u32" => (1, *ty),
+        let (n, scalar) = match ty.as_str() {
+            "f32" | "u32" => (1, ty.as_str()),
             t => (t[3..4].parse::<usize>().ok()?, &t[5..8]),
         };
         let mut parts = vec![];
@@ -155,7 +130,7 @@ fn struct_lit(name: &str, members: &[&str], words: &[u32]) -> Option<String> {
 /// `fn accessor(i: u32) -> ty` returning entry i of `items` through a chain of selections (i out of range gives
 /// entry 0, as a clamped buffer read would give some entry), or reading `buffer_read` when an entry cannot be
 /// written as literals or there is none.
-fn accessor<T: bytemuck::Pod>(name: &str, ty: &str, members: &[&str], items: &[T], buffer_read: &str) -> String {
+fn accessor<T: bytemuck::Pod>(name: &str, ty: &str, members: &[String], items: &[T], buffer_read: &str) -> String {
     let lits: Option<Vec<String>> =
         items.iter().map(|x| struct_lit(ty, members, bytemuck::cast_slice(std::slice::from_ref(x)))).collect();
     match lits {
@@ -186,13 +161,14 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
         })
         .collect();
     let tri_read = "TriPositions(tri_verts[3u * i].xyz, tri_verts[3u * i + 1u].xyz, tri_verts[3u * i + 2u].xyz)";
-    let vec3s = &["vec3<f32>", "vec3<f32>", "vec3<f32>"];
-    out += &accessor("scene_tri_positions", "TriPositions", vec3s, &positions, tri_read);
-    out += &accessor("scene_tri_shading", "TriShading", TRI_SHADING_MEMBERS, &data.tri_shading, "tri_shading[i]");
-    out += &accessor("scene_sphere", "Sphere", SPHERE_MEMBERS, &data.spheres, "spheres[i]");
-    out += &accessor("scene_quad", "Quad", QUAD_MEMBERS, &data.quads, "quads[i]");
-    out += &accessor("scene_material", "Material", MATERIAL_MEMBERS, &data.materials, "materials[i]");
-    out += &accessor("scene_light", "Light", LIGHT_MEMBERS, &data.lights, "lights[i]");
+    let vec3s = vec!["vec3<f32>".to_string(); 3];
+    out += &accessor("scene_tri_positions", "TriPositions", &vec3s, &positions, tri_read);
+    let shading = wgsl_members("TriShading");
+    out += &accessor("scene_tri_shading", "TriShading", &shading, &data.tri_shading, "tri_shading[i]");
+    out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "spheres[i]");
+    out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "quads[i]");
+    out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
+    out += &accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights, "lights[i]");
     Some((out, baked_traverse_source(data)))
 }
 
@@ -305,4 +281,27 @@ fn test_prim(out: &mut String, query: Query, prim: u32, call: &str) {
             writeln!(out, "    occluded = occluded | (({}).w != 0.0 && skip != {prim}u);", call.replace("T_MAX", "t_max"))
         }
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The member lists read from common.wgsl cover every 4-byte word of the Rust twins (no padding words
+    /// exist in these structs: their vec3s are followed by a scalar).
+    #[test]
+    fn member_lists_cover_the_rust_structs() {
+        let words = |ty: &str| -> usize {
+            wgsl_members(ty)
+                .iter()
+                .map(|m| if m == "f32" || m == "u32" { 1 } else { m[3..4].parse::<usize>().unwrap() })
+                .sum()
+        };
+        assert_eq!(4 * words("Material"), std::mem::size_of::<GpuMaterial>());
+        assert_eq!(4 * words("Light"), std::mem::size_of::<GpuLight>());
+        assert_eq!(4 * words("Sphere"), std::mem::size_of::<GpuSphere>());
+        assert_eq!(4 * words("Quad"), std::mem::size_of::<GpuQuad>());
+        assert_eq!(4 * words("TriShading"), std::mem::size_of::<GpuTriShading>());
+        assert_eq!(wgsl_members("Material")[3], "f32");
+    }
 }
