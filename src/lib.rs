@@ -27,6 +27,7 @@ pub mod probe;
 pub mod progressive;
 pub mod reference;
 pub mod render;
+pub mod render_error;
 pub mod sampler_figure;
 pub mod samplers;
 pub mod scene;

@@ -9,6 +9,7 @@ use crate::gpu_scene::GpuScene;
 use crate::gpu_timer::GpuTimer;
 use crate::gpu_types::*;
 use crate::pipeline_cache::PipelineCache;
+pub use crate::render_error::RenderError;
 use crate::scene::Camera;
 use crate::settings::{Mode, Settings};
 use crate::shaders;
@@ -138,10 +139,15 @@ pub struct Renderer {
 
 impl Renderer {
     /// Builds the pipeline and the per-render buffers for `scene` at the settings' film size.
-    pub fn new(ctx: &GpuContext, scene: &GpuScene, camera: Camera, settings: Settings) -> Result<Renderer, String> {
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        camera: Camera,
+        settings: Settings,
+    ) -> Result<Renderer, RenderError> {
         let mut r = Renderer::new_unprepared(ctx, scene, camera, settings)?;
         r.prepare()?;
-        r.warm_up(ctx).map_err(|e| e.to_string())?;
+        r.warm_up(ctx)?;
         Ok(r)
     }
 
@@ -152,8 +158,8 @@ impl Renderer {
         scene: &GpuScene,
         camera: Camera,
         settings: Settings,
-    ) -> Result<Renderer, String> {
-        settings.validate()?;
+    ) -> Result<Renderer, RenderError> {
+        settings.validate().map_err(RenderError::Settings)?;
         let device = ctx.device.clone();
         let scene_entries: Vec<_> = bindings::SCENE.iter().map(|b| bindings::layout_entry(&b.binding)).collect();
         let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -184,13 +190,12 @@ impl Renderer {
         let pixels = settings.width as u64 * settings.height as u64;
         let accum_bytes = pixels * std::mem::size_of::<GpuAccum>() as u64;
         if accum_bytes > ctx.max_storage_binding() {
-            return Err(format!(
-                "a {}x{} film needs {} MiB of accumulation buffer, more than the device's storage-binding limit of {} MiB",
-                settings.width,
-                settings.height,
-                accum_bytes >> 20,
-                ctx.max_storage_binding() >> 20
-            ));
+            return Err(RenderError::FilmTooLarge {
+                width: settings.width,
+                height: settings.height,
+                need_mib: accum_bytes >> 20,
+                limit_mib: ctx.max_storage_binding() >> 20,
+            });
         }
         let accum = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("accum"),
@@ -311,19 +316,21 @@ impl Renderer {
     }
 
     /// Builds (or finds in the cache) the pipeline for the current settings.
-    pub fn prepare(&mut self) -> Result<(), String> {
+    pub fn prepare(&mut self) -> Result<(), RenderError> {
         let key = self.key();
         let (device, layout) = (&self.device, &self.pipeline_layout);
         let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
-        self.pipelines.get_or_build(key, || {
-            shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
-        })?;
+        self.pipelines
+            .get_or_build(key, || {
+                shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
+            })
+            .map_err(RenderError::Pipeline)?;
         Ok(())
     }
 
     /// Switches between specialised and generic pipelines (the viewer runs the generic one while a
     /// specialised one compiles). Does not reset: both compute the same estimate.
-    pub fn set_specialize(&mut self, on: bool) -> Result<(), String> {
+    pub fn set_specialize(&mut self, on: bool) -> Result<(), RenderError> {
         self.specialize = on;
         self.prepare()
     }
@@ -374,10 +381,10 @@ impl Renderer {
         samples: u32,
         nonfinite_total: u64,
         rays_total: u64,
-    ) -> Result<(), String> {
+    ) -> Result<(), RenderError> {
         let pixels = self.settings.width as usize * self.settings.height as usize;
         if accum.len() != pixels {
-            return Err(format!("a state of {} pixels cannot continue a {pixels}-pixel film", accum.len()));
+            return Err(RenderError::StateSize { got: accum.len(), want: pixels });
         }
         self.reset();
         self.queue.write_buffer(&self.accum, 0, bytemuck::cast_slice(accum));
@@ -388,17 +395,17 @@ impl Renderer {
     }
 
     /// Changes settings (film size excluded), resets and builds the pipeline they need.
-    pub fn set_settings(&mut self, settings: Settings) -> Result<(), String> {
+    pub fn set_settings(&mut self, settings: Settings) -> Result<(), RenderError> {
         self.configure(settings)?;
         self.prepare()
     }
 
     /// Changes settings (film size excluded) and resets, without building a pipeline (the viewer's compile worker
     /// builds them on another thread).
-    pub fn configure(&mut self, settings: Settings) -> Result<(), String> {
-        settings.validate()?;
+    pub fn configure(&mut self, settings: Settings) -> Result<(), RenderError> {
+        settings.validate().map_err(RenderError::Settings)?;
         if settings.width != self.settings.width || settings.height != self.settings.height {
-            return Err("the film size cannot change on an existing renderer".into());
+            return Err(RenderError::FilmSizeChange);
         }
         self.settings = settings;
         self.reset();
@@ -581,12 +588,12 @@ impl Renderer {
 
     /// Renders `spp` more samples per pixel and waits for them (with the device timeout): dispatches of at most
     /// `max_dispatch_spp()` samples, one submission each, one wait at the end.
-    pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), String> {
+    pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), RenderError> {
         self.prepare()?;
         // The compile of a pipeline's first use gets its own, longer wait (see PIPELINE_COMPILE_TIMEOUT), so the
         // device timeout below bounds sample work only.
         if self.warmed != Some(self.key()) {
-            self.warm_up(ctx).map_err(|e| e.to_string())?;
+            self.warm_up(ctx)?;
         }
         // lavapipe (Mesa 22.3) gives each invocation one budget of 65535 loop iterations shared by all
         // its loops and silently stops looping when it is spent: a 1024-spp dispatch accumulated only
@@ -604,8 +611,8 @@ impl Renderer {
             left -= n;
             in_flight += n as u64 * pixels;
             if in_flight >= PIXEL_SAMPLES_PER_WAIT || left == 0 {
-                ctx.wait().map_err(|e| e.to_string())?;
-                self.collect_counters(ctx).map_err(|e| e.to_string())?;
+                ctx.wait()?;
+                self.collect_counters(ctx)?;
                 in_flight = 0;
             }
         }
@@ -619,7 +626,7 @@ impl Renderer {
         ctx: &GpuContext,
         spp: u32,
         mut timer: Option<&mut GpuTimer>,
-    ) -> Result<Timing, String> {
+    ) -> Result<Timing, RenderError> {
         self.prepare()?;
         let mut timing = Timing { gpu: timer.as_ref().map(|_| 0.0), ..Timing::default() };
         let rays_before = self.rays_total;
@@ -631,16 +638,16 @@ impl Renderer {
             let mut enc = self.device.create_command_encoder(&Default::default());
             self.record(&mut enc, n, timer.as_deref_mut());
             self.queue.submit([enc.finish()]);
-            ctx.wait().map_err(|e| e.to_string())?;
+            ctx.wait()?;
             timing.wall += t0.elapsed().as_secs_f64();
             left -= n;
             let full = timer.as_ref().is_some_and(|t| t.is_full());
             if full || left == 0 {
                 if let (Some(t), Some(g)) = (timer.as_deref_mut(), timing.gpu.as_mut()) {
-                    *g += t.read(ctx).map_err(|e| e.to_string())?.iter().sum::<f64>();
+                    *g += t.read(ctx)?.iter().sum::<f64>();
                 }
                 // Also bounds the device's 32-bit ray counter between readbacks.
-                self.collect_counters(ctx).map_err(|e| e.to_string())?;
+                self.collect_counters(ctx)?;
             }
         }
         timing.rays = self.rays_total - rays_before;

@@ -223,6 +223,12 @@ impl From<String> for SeedError {
     }
 }
 
+impl From<crate::render::RenderError> for SeedError {
+    fn from(e: crate::render::RenderError) -> Self {
+        SeedError::Other(e.to_string())
+    }
+}
+
 /// One configuration and seed over the ladder (or the time budget). Progressive samplers render the ladder as
 /// prefixes of one run; fixed-count ones (stratified, Hammersley) render each point afresh with their target
 /// set to it. Returns the points, the last one with its per-pixel relMSE.

@@ -96,7 +96,7 @@ fn compile_worker(
         if let Some((c, _, r)) = warm.as_mut() {
             r.set_baked_source(&job.source);
             if r.aim_at(job.key, job.settings.clone()) {
-                let _ = r.prepare().and_then(|_| r.warm_up(c).map_err(|e| e.to_string()));
+                let _ = r.prepare().and_then(|_| Ok(r.warm_up(c)?));
             }
         }
         let constants = job.key.constants();

@@ -1,0 +1,37 @@
+//! Why the renderer could not do what it was asked: the render layer's error type. Every variant's message
+//! stands alone (the CLI prints it after the scene's name and exits 2).
+
+use crate::gpu::GpuError;
+
+/// An error from [`crate::render::Renderer`].
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// Waiting on or reading back from the device failed.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// The settings are out of range (`Settings::validate`'s message).
+    #[error("{0}")]
+    Settings(String),
+    /// A render pipeline could not be built (shader composition or validation).
+    #[error("{0}")]
+    Pipeline(String),
+    /// The film's accumulation buffer does not fit one storage binding.
+    #[error(
+        "a {width}x{height} film needs {need_mib} MiB of accumulation buffer, more than the device's \
+         storage-binding limit of {limit_mib} MiB"
+    )]
+    FilmTooLarge { width: u32, height: u32, need_mib: u64, limit_mib: u64 },
+    /// A saved state of another film size was handed to `restore`.
+    #[error("a state of {got} pixels cannot continue a {want}-pixel film")]
+    StateSize { got: usize, want: usize },
+    /// `configure` was asked to change the film size.
+    #[error("the film size cannot change on an existing renderer")]
+    FilmSizeChange,
+}
+
+/// Layers above that still speak in messages take a render error as its message.
+impl From<RenderError> for String {
+    fn from(e: RenderError) -> String {
+        e.to_string()
+    }
+}
