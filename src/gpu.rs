@@ -31,6 +31,21 @@ pub enum GpuError {
     /// A buffer could not be mapped for readback.
     #[error("reading back from the GPU failed: {0}")]
     Map(String),
+    /// A scene buffer exceeds the device's storage-buffer binding limit.
+    #[error(
+        "the scene is too large for this device: its {buffer} need {:.1} MiB ({bytes} bytes), more than the \
+         device's max_storage_buffer_binding_size of {} MiB ({limit} bytes)",
+        *bytes as f64 / (1u64 << 20) as f64,
+        limit >> 20
+    )]
+    SceneTooLarge { buffer: &'static str, bytes: u64, limit: u64 },
+}
+
+/// Layers above that still speak in messages take a GPU error as its message.
+impl From<GpuError> for String {
+    fn from(e: GpuError) -> String {
+        e.to_string()
+    }
 }
 
 /// One adapter as `mislab info` prints it.

@@ -3,7 +3,7 @@
 
 use crate::bindings;
 use crate::bvh;
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, GpuError};
 use crate::gpu_types::*;
 use crate::light_tree::{GpuLightNode, LightBounds, LightTree};
 use crate::lights::{self, luminance};
@@ -467,16 +467,10 @@ pub fn binding_sizes(data: &SceneData) -> [u64; bindings::SCENE.len()] {
 
 /// Checks every group-0 buffer against a device's storage-buffer binding limit (bytes). The error names the
 /// buffer, its size and the limit, so that the user knows what to shrink.
-pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), String> {
-    let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
-    for (b, size) in bindings::SCENE.iter().zip(binding_sizes(data)) {
-        let name = b.binding.label;
-        if size > limit {
-            return Err(format!(
-                "the scene is too large for this device: its {name} need {:.1} MiB ({size} bytes), more than the device's max_storage_buffer_binding_size of {} MiB ({limit} bytes)",
-                mib(size),
-                limit >> 20,
-            ));
+pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), GpuError> {
+    for (b, bytes) in bindings::SCENE.iter().zip(binding_sizes(data)) {
+        if bytes > limit {
+            return Err(GpuError::SceneTooLarge { buffer: b.binding.label, bytes, limit });
         }
     }
     Ok(())
@@ -485,7 +479,7 @@ pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), String> {
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
     /// larger than the device's storage-buffer binding limit.
-    pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, String> {
+    pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, GpuError> {
         check_binding_sizes(&data, ctx.max_storage_binding())?;
         let buffers = bindings::SCENE
             .iter()

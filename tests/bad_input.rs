@@ -343,14 +343,14 @@ fn binding_size_check_names_the_buffer_and_the_limit() {
     check_binding_sizes(&data, limit).unwrap();
     // One texel more does not, and the message says which buffer, how large, and the limit.
     let data = SceneData { tex_texels: vec![0; (limit / 4) as usize + 1], ..Default::default() };
-    let e = check_binding_sizes(&data, limit).unwrap_err();
+    let e = check_binding_sizes(&data, limit).unwrap_err().to_string();
     for want in ["its texels need 1.0 MiB (1048580 bytes)", "max_storage_buffer_binding_size of 1 MiB (1048576 bytes)"]
     {
         assert!(e.contains(want), "{e}");
     }
     // Triangles: 16 bytes per vertex, three per triangle.
     let data = SceneData { tri_verts: vec![[0.0; 4]; 3 * 30_000], ..Default::default() };
-    let e = check_binding_sizes(&data, limit).unwrap_err();
+    let e = check_binding_sizes(&data, limit).unwrap_err().to_string();
     assert!(e.contains("triangle vertices") && e.contains("1440000 bytes"), "{e}");
 }
 
