@@ -20,6 +20,15 @@ use glam::Vec3;
 use std::collections::HashMap;
 use std::fmt::Write;
 
+/// Largest primitive count rendered without a BVH (`Features::flat`).
+pub const FLAT_MAX_PRIMS: usize = 32;
+
+/// (triangles, spheres, quads) of a scene small enough to test every primitive without a BVH.
+pub fn flat_counts(data: &SceneData) -> Option<(u32, u32, u32)> {
+    let n = (data.tri_shading.len(), data.spheres.len(), data.quads.len());
+    (n.0 + n.1 + n.2 <= FLAT_MAX_PRIMS).then_some((n.0 as u32, n.1 as u32, n.2 as u32))
+}
+
 /// A WGSL f32 literal that round-trips exactly (Rust's shortest representation, with the `f` suffix).
 fn lit(x: f32) -> String {
     let s = format!("{x:?}");
@@ -148,7 +157,7 @@ fn accessor<T: bytemuck::Pod>(name: &str, ty: &str, members: &[String], items: &
 /// The generated `scene_data.wgsl` and `baked_geometry.wgsl` for `data` (the shader files of those names are the
 /// stubs: they list the functions to define), or None when the scene is too large to bake (`Features::flat`).
 pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
-    crate::features::flat_counts(data)?;
+    flat_counts(data)?;
     let mut out = String::from(
         "// scene_data.wgsl, generated for one scene by src/baked.rs: its tables as literals.\n\n\
          struct TriPositions {\n    v0: vec3<f32>,\n    v1: vec3<f32>,\n    v2: vec3<f32>,\n}\n\n",

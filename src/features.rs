@@ -56,15 +56,6 @@ pub struct Features {
     pub baked: u64,
 }
 
-/// Largest primitive count rendered without a BVH (`Features::flat`).
-pub const FLAT_MAX_PRIMS: usize = 32;
-
-/// (triangles, spheres, quads) of a scene small enough to test every primitive without a BVH.
-pub fn flat_counts(data: &SceneData) -> Option<(u32, u32, u32)> {
-    let n = (data.tri_shading.len(), data.spheres.len(), data.quads.len());
-    (n.0 + n.1 + n.2 <= FLAT_MAX_PRIMS).then_some((n.0 as u32, n.1 as u32, n.2 as u32))
-}
-
 impl Features {
     /// Everything compiled in.
     pub fn generic() -> Features {
@@ -111,7 +102,7 @@ impl Features {
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
             many_lights: data.lights.len() > 1,
-            flat: flat_counts(data),
+            flat: crate::baked::flat_counts(data),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {
                 use std::hash::{Hash, Hasher};
                 let mut h = std::collections::hash_map::DefaultHasher::new();

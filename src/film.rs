@@ -58,6 +58,11 @@ pub fn tonemap(x: f32, exposure: f32, op: Tonemap) -> f32 {
 }
 
 impl Film {
+    /// The mean image, as the EXR writer takes it.
+    pub fn pixels(&self) -> crate::exr_image::Pixels<'_> {
+        crate::exr_image::Pixels { width: self.width, height: self.height, rgb: &self.mean }
+    }
+
     /// Builds a film from the device's accumulators.
     pub fn from_accum(width: u32, height: u32, accum: &[GpuAccum], nonfinite_total: u64) -> Film {
         Film {
@@ -133,7 +138,7 @@ impl Film {
         let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
         match ext.as_str() {
             "png" => target.write(|tmp| write_png(tmp, &self.to_rgb8(exposure, op), attributes)),
-            "exr" => target.write(|tmp| crate::reference::encode_exr(tmp, self, attributes)),
+            "exr" => target.write(|tmp| crate::exr_image::encode(tmp, self.pixels(), attributes)),
             _ => Err(format!("{}: unknown output format '.{ext}' (use .png or .exr)", path.display())),
         }
     }

@@ -10,6 +10,7 @@ pub mod bvh;
 pub mod chi2;
 pub mod cli_values;
 pub mod convex_solids;
+pub mod exr_image;
 pub mod features;
 pub mod figure;
 pub mod film;

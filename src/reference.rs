@@ -2,6 +2,7 @@
 //! written as linear EXR whose header records the sample count, the render time, the scene and every setting
 //! (custom attributes); and reading such references back for `mislab bench`.
 
+pub use crate::exr_image::ReferenceImage;
 use crate::film::Film;
 use crate::gpu::GpuContext;
 use crate::gpu_scene::{GpuScene, SceneData};
@@ -10,7 +11,6 @@ use crate::progressive::{Budget, RenderStats};
 use crate::render::Renderer;
 use crate::scene::{Scene, SceneSpec};
 use crate::settings::*;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -196,74 +196,18 @@ pub fn header_attributes(scene: &SceneSpec, settings: &Settings, stats: &RenderS
     ]
 }
 
-fn text(s: &str) -> exr::meta::attribute::Text {
-    use exr::meta::attribute::Text;
-    Text::new_or_none(s).unwrap_or_else(|| {
-        Text::new_or_panic(s.chars().map(|c| if (c as u32) < 256 { c } else { '?' }).collect::<String>())
-    })
-}
-
-/// Writes linear RGB float32 EXR with `attributes` as text attributes of the layer (written to a temporary
-/// file and renamed; see `output_file`).
+/// Writes `film` as linear float EXR with `attributes` (see `header_attributes`) as text attributes.
 pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), String> {
-    crate::output_file::check(path, true)?.write(|tmp| encode_exr(tmp, film, attributes))
+    crate::exr_image::write(path, film.pixels(), attributes)
 }
 
-/// Encodes `film` as linear RGB float32 EXR at `path`, with `attributes` as text attributes of the layer.
-pub fn encode_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), String> {
-    use exr::prelude::*;
-    let (w, h) = (film.width as usize, film.height as usize);
-    let mut layer_attributes = LayerAttributes::named("mislab");
-    layer_attributes.software_name = Some(text("mislab"));
-    for (k, v) in attributes {
-        layer_attributes.other.insert(text(k), AttributeValue::Text(text(v)));
-    }
-    let pixels = &film.mean;
-    let layer = Layer::new(
-        (w, h),
-        layer_attributes,
-        Encoding::FAST_LOSSLESS,
-        SpecificChannels::rgb(|p: Vec2<usize>| {
-            let c = pixels[p.y() * w + p.x()];
-            (c[0], c[1], c[2])
-        }),
-    );
-    Image::from_layer(layer).write().to_file(path).map_err(|e| format!("EXR: {e}"))
-}
-
-/// A reference read back: size, linear RGB pixels, and its text attributes.
-#[derive(Clone, Debug)]
-pub struct ReferenceImage {
-    /// Width.
-    pub width: u32,
-    /// Height.
-    pub height: u32,
-    /// Row-major RGB.
-    pub pixels: Vec<[f32; 3]>,
-    /// Text attributes of the first layer (empty for EXRs from elsewhere).
-    pub attributes: BTreeMap<String, String>,
-}
-
-/// Reads an EXR (any writer) and, where present, the attributes `write_exr` records.
+/// Reads a reference: a linear image (EXR from mislab or elsewhere), or a render state (`mislab merge`'s merged
+/// state, or a whole render's), with the attributes `write_exr` records where present.
 pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
-    // A render state (`mislab merge`'s merged state, or a whole render's) is a reference too.
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("state")) {
         return crate::state::RenderState::read(path).map(|s| s.reference_image());
     }
-    let img = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.into_rgb32f();
-    let (width, height) = img.dimensions();
-    let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
-    let mut attributes = BTreeMap::new();
-    if let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) {
-        if let Some(header) = meta.headers.first() {
-            for (k, v) in &header.own_attributes.other {
-                if let exr::meta::attribute::AttributeValue::Text(t) = v {
-                    attributes.insert(k.to_string(), t.to_string());
-                }
-            }
-        }
-    }
-    Ok(ReferenceImage { width, height, pixels, attributes })
+    crate::exr_image::read(path)
 }
 
 /// Runs `mislab reference`; returns the exit code (0, or 130 when interrupted after writing what it had).

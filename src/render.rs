@@ -11,6 +11,7 @@ use crate::gpu_types::*;
 use crate::pipeline_cache::PipelineCache;
 pub use crate::render_error::RenderError;
 use crate::scene::Camera;
+pub use crate::settings::RR_DEPTH;
 use crate::settings::{Mode, Settings};
 use crate::shaders;
 use std::time::Instant;
@@ -36,9 +37,6 @@ pub const RENDER_FILES: &[&str] = &[
     "estimators.wgsl",
     "integrator.wgsl",
 ];
-
-/// Default bounce count from which Russian roulette decides whether a path continues (issue 3: "after depth 3").
-pub const RR_DEPTH: u32 = 3;
 
 /// The render module that reads the scene from its buffers (the generic pipeline, shared between scenes).
 pub fn render_source() -> String {

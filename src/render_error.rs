@@ -3,7 +3,7 @@
 
 use crate::gpu::GpuError;
 
-/// An error from [`crate::render::Renderer`].
+/// An error from the renderer (`render::Renderer`).
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// Waiting on or reading back from the device failed.

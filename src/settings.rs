@@ -3,6 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Default bounce count from which Russian roulette decides whether a path continues (issue 3: "after depth 3").
+pub const RR_DEPTH: u32 = 3;
+
 /// Declares a settings enum whose discriminants are the WGSL tag constants, with kebab-case names
 /// (the CLI / viewer / bench spelling) and an `ALL` list that tests and the viewer iterate over.
 macro_rules! settings_enum {
@@ -218,7 +221,7 @@ impl Default for Settings {
             bsdf_samples: 1,
             sampler: SamplerKind::Independent,
             max_depth: 8,
-            rr_depth: crate::render::RR_DEPTH,
+            rr_depth: RR_DEPTH,
             seed: 0,
             exposure: 0.0,
         }

@@ -208,7 +208,7 @@ pub fn run(args: &MergeArgs) -> Result<u8, String> {
     merged.write(&state_path)?;
     let film = merged.film();
     if ext == "exr" {
-        crate::reference::write_exr(&output, &film, &exr_attributes(&merged.header, parts.len()))?;
+        crate::exr_image::write(&output, film.pixels(), &exr_attributes(&merged.header, parts.len()))?;
     } else {
         film.save(&output, args.exposure, args.tonemap)?;
     }

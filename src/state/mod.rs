@@ -191,13 +191,13 @@ impl RenderState {
     }
 
     /// The mean image with a reference EXR's attributes (`mislab bench --ref` reads states through this).
-    pub fn reference_image(&self) -> crate::reference::ReferenceImage {
+    pub fn reference_image(&self) -> crate::exr_image::ReferenceImage {
         let s = &self.header.settings;
         let attributes = merge::exr_attributes(&self.header, 0)
             .into_iter()
             .chain([("stateSamples".to_string(), format!("{}..{}", self.header.range.0, self.header.next))])
             .collect();
-        crate::reference::ReferenceImage {
+        crate::exr_image::ReferenceImage {
             width: s.width,
             height: s.height,
             pixels: self.accum.iter().map(|a| a.mean).collect(),
