@@ -119,13 +119,7 @@ pub fn map(
                 }
             }
         }
-        "coateddiffuse" | "plastic" | "roughplastic" => {
-            let (c, t) = color(desc, &["reflectance", "diffuse_reflectance"], Vec3::splat(0.5), scene, cache)?;
-            warn("a glTF dielectric (GGX specular with F0 0.04 over Lambert)");
-            let alpha = alpha_of(desc).max(super::ALPHA_MIN);
-            let mat = Material { specular: 1.0, roughness: alpha.sqrt(), ..Material::lambert(&desc.name, c) };
-            with_texture(mat, t)
-        }
+        "coateddiffuse" | "plastic" | "roughplastic" => return coated_diffuse(desc, scene, cache, warnings),
         "diffusetransmission" => {
             let (c, t) = color(desc, &["reflectance"], Vec3::splat(0.25), scene, cache)?;
             warn("Lambert reflection only (its transmission is dropped)");
@@ -145,6 +139,128 @@ pub fn map(
         }
     };
     Ok(Mapped::Material(Box::new(m)))
+}
+
+/// pbrt-v4 `coateddiffuse` and Mitsuba `plastic` / `roughplastic` onto `MaterialKind::CoatedDiffuse` (the analytic
+/// coat-over-Lambert model; docs/materials.md measures it against pbrt's stochastic layered evaluation).
+fn coated_diffuse(
+    desc: &MaterialDesc,
+    scene: &mut Scene,
+    cache: &mut TextureCache,
+    warnings: &mut Vec<String>,
+) -> Result<Mapped, SceneError> {
+    let mut warn = |what: &str| warnings.push(format!("material {} ({}): {what}", desc.name, desc.kind));
+    let f = |n: &str| match desc.params.get(n) {
+        Some(MatParam::Float(v)) => Some(*v),
+        Some(MatParam::Rgb(c)) => Some(c.x),
+        _ => None,
+    };
+    let pbrt = desc.kind == "coateddiffuse";
+    let (mut c, t) = color(desc, &["reflectance", "diffuse_reflectance"], Vec3::splat(0.5), scene, cache)?;
+    // Smooth (Mitsuba `plastic`, pbrt roughness 0) is α = 0, which the GPU clamps to ALPHA_MIN.
+    let alpha = if desc.kind == "plastic" { 0.0 } else { alpha_of(desc) };
+    let alpha = if desc.kind == "roughplastic" && !desc.params.contains_key("alpha") && alpha_uv(desc).is_none() {
+        0.1 // Mitsuba's default
+    } else {
+        alpha
+    };
+    let (au, av) = if desc.kind == "plastic" { (0.0, 0.0) } else { alpha_uv(desc).unwrap_or((alpha, alpha)) };
+    let eta = if pbrt {
+        match desc.params.get("eta") {
+            None => 1.5,
+            Some(MatParam::Float(e)) => *e,
+            Some(MatParam::Rgb(e)) => e.x,
+            Some(other) => {
+                warn(&format!("eta {other:?} is not a number; the coat uses η = 1.5"));
+                1.5
+            }
+        }
+    } else {
+        mitsuba_ior(desc, "int_ior", 1.49, &mut warn) / mitsuba_ior(desc, "ext_ior", 1.000277, &mut warn)
+    };
+    let eta = if eta > 1.0 && eta.is_finite() {
+        eta
+    } else {
+        warn(&format!("a coat of relative η = {eta} (the model needs η > 1) rendered with η = 1.5"));
+        1.5
+    };
+    if pbrt {
+        // pbrt's medium between coat and base: the analytic model has none (thickness 0.01 with albedo 0 only
+        // absorbs exp(−0.01/cosθ) per crossing in pbrt; the table in docs/materials.md includes it).
+        let medium = f("albedo").is_some_and(|a| a != 0.0)
+            || desc.params.get("albedo").is_some_and(|a| !matches!(a, MatParam::Float(_) | MatParam::Rgb(_)))
+            || f("g").is_some_and(|g| g != 0.0)
+            || f("thickness").is_some_and(|d| (d - 0.01).abs() > 1e-6);
+        if medium {
+            warn("its layer medium (thickness/albedo/g) is ignored: the analytic coat has no medium");
+        }
+    } else {
+        if !matches!(desc.params.get("nonlinear"), Some(MatParam::Bool(true))) {
+            // Mitsuba's default linear form: its reflectance is the base's share; converted exactly for colours.
+            let fi = super::coated::coated_internal_reflectance(eta);
+            let lin = |r: f32| super::coated::reflectance_from_linear(r, fi);
+            c = Vec3::new(lin(c.x), lin(c.y), lin(c.z));
+            if t.is_some() {
+                warn("Mitsuba's linear (nonlinear = false) reflectance of a texture converted at the texture factor");
+            }
+        }
+        if desc.kind == "roughplastic"
+            && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx")
+        {
+            warn("a Beckmann coat rendered as GGX of the same α");
+        }
+        if f("specular_reflectance").is_some_and(|s| s != 1.0) {
+            warn("specular_reflectance other than 1 is ignored");
+        }
+    }
+    let m = Material {
+        kind: MaterialKind::CoatedDiffuse { eta, alpha_u: au, alpha_v: av },
+        ..Material::coated_diffuse(&desc.name, c, eta, au)
+    };
+    Ok(Mapped::Material(Box::new(with_texture(m, t))))
+}
+
+/// A Mitsuba index of refraction: a number, or one of the names of Mitsuba's IOR table (its common entries).
+fn mitsuba_ior(desc: &MaterialDesc, name: &str, default: f32, warn: &mut impl FnMut(&str)) -> f32 {
+    const NAMED: &[(&str, f32)] = &[
+        ("vacuum", 1.0),
+        ("helium", 1.000036),
+        ("hydrogen", 1.000132),
+        ("air", 1.000277),
+        ("carbon dioxide", 1.00045),
+        ("water", 1.3330),
+        ("acetone", 1.36),
+        ("ethanol", 1.361),
+        ("carbon tetrachloride", 1.461),
+        ("glycerol", 1.4729),
+        ("benzene", 1.501),
+        ("silicone oil", 1.52045),
+        ("bromine", 1.661),
+        ("water ice", 1.31),
+        ("fused quartz", 1.458),
+        ("pyrex", 1.470),
+        ("acrylic glass", 1.49),
+        ("polypropylene", 1.49),
+        ("bk7", 1.5046),
+        ("sodium chloride", 1.544),
+        ("amber", 1.55),
+        ("pet", 1.5750),
+        ("diamond", 2.419),
+    ];
+    match desc.params.get(name) {
+        None => default,
+        Some(MatParam::Float(v)) => *v,
+        Some(MatParam::Str(s)) => {
+            NAMED.iter().find(|(n, _)| n.eq_ignore_ascii_case(s)).map(|(_, v)| *v).unwrap_or_else(|| {
+                warn(&format!("unknown {name} \"{s}\"; {default} used"));
+                default
+            })
+        }
+        Some(other) => {
+            warn(&format!("{name} {other:?} is not a number; {default} used"));
+            default
+        }
+    }
 }
 
 fn with_texture(mut m: Material, t: Option<TextureRef>) -> Material {
