@@ -59,16 +59,6 @@ pub enum Mapped {
     Invisible,
 }
 
-/// Normal-incidence reflectance of common conductors, linear Rec.709 (the usual published F0 table values),
-/// for pbrt's named `metal-*-eta` / `metal-*-k` spectra.
-const NAMED_METALS: &[(&str, [f32; 3])] = &[
-    ("Ag", [0.972, 0.960, 0.915]),
-    ("Al", [0.913, 0.922, 0.924]),
-    ("Au", [1.000, 0.766, 0.336]),
-    ("Cu", [0.955, 0.638, 0.538]),
-    ("CuZn", [0.910, 0.778, 0.423]),
-];
-
 /// Maps `desc` onto a mislab material, loading its textures into `scene` (through `cache`). Approximations add
 /// one warning each to `warnings`.
 pub fn map(
@@ -90,22 +80,18 @@ pub fn map(
                 warn("a conductor without its coat");
             }
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
-            match (desc.params.get("eta"), desc.params.get("k"), t) {
-                // RGB η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
-                (Some(MatParam::Rgb(eta)), Some(MatParam::Rgb(k)), None)
-                    if desc.params.get("reflectance").is_none() =>
-                {
-                    Material {
-                        kind: MaterialKind::Conductor { eta: *eta, k: *k, alpha_u: au, alpha_v: av },
-                        ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
-                    }
-                }
+            match (conductor_eta_k(desc), t) {
+                // RGB or named η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
+                (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => Material {
+                    kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av },
+                    ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
+                },
                 // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
                 // normal-incidence reflectance, NAMED_METALS): the complex-Fresnel conductor of that F(0).
-                (_, _, None) => {
+                (_, None) => {
                     let f0 = if desc.params.contains_key("reflectance") { c } else { conductor_f0(desc) * c };
-                    if desc.params.contains_key("eta") && desc.params.get("reflectance").is_none() {
-                        warn("a complex-Fresnel conductor with the named metal's normal-incidence reflectance");
+                    if desc.params.get("reflectance").is_none() {
+                        warn("a complex-Fresnel conductor of reflectance 0.9 (a spectrum not in the named-spectra table)");
                     }
                     Material {
                         kind: MaterialKind::conductor_from_reflectance(f0, au, av),
@@ -113,7 +99,7 @@ pub fn map(
                     }
                 }
                 // A textured reflectance: the Fresnel-free GGX conductor, which reads the texture.
-                (_, _, Some(t)) => {
+                (_, Some(t)) => {
                     warn("a Fresnel-free GGX conductor with its textured normal-incidence reflectance");
                     with_texture(Material::conductor(&desc.name, conductor_f0(desc) * c, alpha), Some(t))
                 }
@@ -331,22 +317,32 @@ fn alpha_uv(desc: &MaterialDesc) -> Option<(f32, f32)> {
     Some(if remap { (u.sqrt(), v.sqrt()) } else { (u, v) })
 }
 
-/// Normal-incidence Fresnel reflectance from `eta` / `k` (RGB or a named metal); Cu, pbrt's default, if absent.
-fn conductor_f0(desc: &MaterialDesc) -> Vec3 {
-    let named = |s: &str| {
-        let metal = s.trim_start_matches("metal-").split('-').next().unwrap_or("");
-        NAMED_METALS.iter().find(|(n, _)| *n == metal).map(|(_, c)| Vec3::from_array(*c))
+/// RGB η and k of a conductor: RGB values, pbrt's named spectra (`metal-Au-eta`; super::named_spectra), Mitsuba's
+/// `material` name, or pbrt's default (copper) when neither is given. None when a name is not in the table.
+fn conductor_eta_k(desc: &MaterialDesc) -> Option<(Vec3, Vec3)> {
+    use super::named_spectra::{lookup, Part};
+    let get = |name: &str, part: Part| match desc.params.get(name) {
+        Some(MatParam::Rgb(c)) => Some(*c),
+        Some(MatParam::Float(f)) => Some(Vec3::splat(*f)),
+        Some(MatParam::Spectrum(s)) => lookup(s, part),
+        None => None,
+        _ => None,
     };
-    match (desc.params.get("eta"), desc.params.get("k")) {
-        (Some(MatParam::Rgb(eta)), Some(MatParam::Rgb(k))) => {
-            let f = |n: f32, k: f32| ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
-            Vec3::new(f(eta.x, k.x), f(eta.y, k.y), f(eta.z, k.z))
+    if let Some(MatParam::Str(m)) = desc.params.get("material") {
+        if desc.params.get("eta").is_none() && desc.params.get("k").is_none() {
+            return Some((lookup(&format!("metal-{m}-eta"), Part::Eta)?, lookup(&format!("metal-{m}-k"), Part::K)?));
         }
-        (Some(MatParam::Spectrum(s)), _) => named(s).unwrap_or(Vec3::splat(0.9)),
-        (None, None) if desc.params.contains_key("material") => Vec3::splat(0.9),
-        (None, None) => Vec3::from_array(NAMED_METALS[3].1),
-        _ => Vec3::splat(0.9),
     }
+    let absent = |n: &str| !desc.params.contains_key(n);
+    let eta = if absent("eta") { lookup("metal-Cu-eta", Part::Eta) } else { get("eta", Part::Eta) }?;
+    let k = if absent("k") { lookup("metal-Cu-k", Part::K) } else { get("k", Part::K) }?;
+    Some((eta, k))
+}
+
+/// Normal-incidence Fresnel reflectance of the conductor's η / k (copper's if absent); 0.9 for names not in the
+/// table.
+fn conductor_f0(desc: &MaterialDesc) -> Vec3 {
+    conductor_eta_k(desc).map_or(Vec3::splat(0.9), |(eta, k)| super::named_spectra::f0(eta, k))
 }
 
 #[cfg(test)]
@@ -391,10 +387,20 @@ mod tests {
             other => panic!("conductor mapped to {other:?}"),
         }
         assert!(w.is_empty(), "{w:?}");
-        // A named metal: its normal-incidence reflectance as a complex-Fresnel conductor, with a warning.
-        let d = desc("conductor", vec![("eta", MatParam::Spectrum("metal-Au-eta".into()))]);
+        // A named metal: its RGB η and k from the named-spectra table, exactly, without a warning.
+        let d = desc(
+            "conductor",
+            vec![("eta", MatParam::Spectrum("metal-Au-eta".into())), ("k", MatParam::Spectrum("metal-Au-k".into()))],
+        );
         let Mapped::Material(m) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
-        assert!(matches!(m.kind, MaterialKind::Conductor { .. }));
-        assert_eq!(w.len(), 1);
+        let au = |p| crate::scene::named_spectra::lookup(p, crate::scene::named_spectra::Part::Eta);
+        assert!(matches!(m.kind, MaterialKind::Conductor { eta, .. } if Some(eta) == au("metal-Au-eta")));
+        assert!(w.is_empty(), "{w:?}");
+        // pbrt's default conductor is copper; an unknown spectrum name is approximated with a warning.
+        let Mapped::Material(m) = map(&desc("conductor", vec![]), &mut s, &mut c, &mut w).unwrap() else { panic!() };
+        assert!(matches!(m.kind, MaterialKind::Conductor { k, .. } if k.x > 3.0 && k.z < 2.5), "{:?}", m.kind);
+        let d = desc("conductor", vec![("eta", MatParam::Spectrum("metal-Xx-eta".into()))]);
+        let Mapped::Material(_) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
+        assert_eq!(w.len(), 1, "{w:?}");
     }
 }

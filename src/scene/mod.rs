@@ -11,6 +11,7 @@ pub mod import_material;
 pub mod import_texture;
 pub mod many_lights;
 pub mod mitsuba;
+pub mod named_spectra;
 pub mod obj;
 pub mod pbrt;
 pub mod pfm;
