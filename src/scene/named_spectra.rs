@@ -1,8 +1,9 @@
 //! pbrt-v4's named spectra for conductors (`"spectrum eta" "metal-Au-eta"`, `"metal-Au-k"`, ...) as RGB η and k.
 //!
-//! Source: the tabulated η(λ), k(λ) that pbrt-v4 ships for these names (src/pbrt/util/spectrum.cpp; Ag, Al, Au, Cu
-//! on a 299–886 nm grid, MgO and TiO2 as dielectrics), which pbrt takes from published measurements (the classic
-//! PBRT metal tables after Palik's *Handbook of Optical Constants of Solids*).
+//! Source: the tabulated η(λ), k(λ) that pbrt-v4 ships for these names (src/pbrt/util/spectrum.cpp, Apache-2.0: Ag,
+//! Al, Au, Cu on a 299–886 nm grid, MgO 310–768 nm and TiO2 306–900 nm as dielectrics); that file does not name the
+//! measurement behind each metal table. Only the reduced RGB numbers below are ours to keep; the spectra are not
+//! copied here.
 //! Reduction to RGB, computed once (not at run time): each spectrum s(λ) is projected onto the linear sRGB
 //! channels, c = ∫ s(λ)·w_c(λ) dλ / ∫ w_c(λ) dλ over 360–830 nm at 1 nm, with w_c the sRGB colour-matching
 //! functions (the XYZ→linear-sRGB matrix of IEC 61966-2-1 applied to the CIE 1931 x̄ ȳ z̄, here the multi-lobe
