@@ -94,6 +94,7 @@ fn bsdf_specular_probability(p: BsdfParams, wo: vec3<f32>) -> f32 {
 /// f_r(wo, wi) without the cosine. Zero below either hemisphere.
 fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_eval(p, wo, wi); }
+    if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_eval(p, wo, wi); }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return vec3<f32>(0.0); }
     let h = normalize(wo + wi);
     let fw = schlick_weight(dot(wo, h));
@@ -112,6 +113,7 @@ fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 /// pdf (solid angle) of `bsdf_sample` producing wi: the mixture of cosine and visible-normal sampling.
 fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_pdf(p, wo, wi); }
+    if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_pdf(p, wo, wi); }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
     let ps = bsdf_specular_probability(p, wo);
     var pdf = (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
@@ -123,6 +125,7 @@ fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 /// pdf = 0 marks a failed sample (below the surface).
 fn bsdf_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
     if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_sample(p, wo, u); }
+    if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_sample(p, wo, u_lobe, u); }
     var s: BsdfSample;
     s.pdf = 0.0;
     s.f = vec3<f32>(0.0);

@@ -124,6 +124,7 @@ struct Material {
 
 const MATERIAL_METALLIC_ROUGHNESS: u32 = 0u;
 const MATERIAL_CONDUCTOR: u32 = 1u;
+const MATERIAL_COATED_DIFFUSE: u32 = 3u;
 
 /// One entry of the light table. For area lights `prim` indexes triangles/spheres/quads; for
 /// punctual lights `position`/`direction` are used. `pmf` is this light's selection probability under
@@ -272,6 +273,8 @@ override HAS_TEXTURES: bool = true;
 override HAS_SPECULAR: bool = true;
 /// Any MaterialKind::Conductor (bsdf_conductor.wgsl).
 override HAS_CONDUCTOR: bool = true;
+/// Any MaterialKind::CoatedDiffuse (bsdf_coated_diffuse.wgsl).
+override HAS_COATED_DIFFUSE: bool = true;
 /// Whether any material has a diffuse lobe.
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.

@@ -45,6 +45,8 @@ pub struct Features {
     pub diffuse: bool,
     /// Any `MaterialKind::Conductor` (shaders/bsdf_conductor.wgsl).
     pub conductor: bool,
+    /// Any `MaterialKind::CoatedDiffuse` (shaders/bsdf_coated_diffuse.wgsl).
+    pub coated_diffuse: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
     /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
@@ -72,6 +74,7 @@ impl Features {
             specular: true,
             diffuse: true,
             conductor: true,
+            coated_diffuse: true,
             many_lights: true,
             flat: None,
             baked: 0,
@@ -101,6 +104,7 @@ impl Features {
             specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
+            coated_diffuse: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_COATED_DIFFUSE),
             many_lights: data.lights.len() > 1,
             flat: crate::baked::flat_counts(data),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {
@@ -128,6 +132,7 @@ impl Features {
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("HAS_CONDUCTOR", b(self.conductor)),
+            ("HAS_COATED_DIFFUSE", b(self.coated_diffuse)),
             ("MANY_LIGHTS", b(self.many_lights)),
             ("FLAT_SCENE", b(self.flat.is_some())),
         ]
@@ -152,6 +157,7 @@ impl Features {
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);
+        on("coated diffuse (GGX dielectric coat over Lambert)", self.coated_diffuse);
         on("light selection", self.many_lights);
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));

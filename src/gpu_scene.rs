@@ -222,6 +222,15 @@ fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
             alpha_v: alpha(*alpha_v),
             ..Default::default()
         },
+        // Reflectance: base_color / base_tex, as for metallic-roughness. η ≥ 1 + 1e-4 (the model has no
+        // total internal reflection from outside; η = 1 would be no coat at all).
+        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v } => GpuMaterial {
+            bsdf_kind: MATERIAL_COATED_DIFFUSE,
+            eta: [finite(*eta, 1.5).clamp(1.0001, 10.0), 1.0, 1.0],
+            alpha: alpha(*alpha_u),
+            alpha_v: alpha(*alpha_v),
+            ..Default::default()
+        },
     }
 }
 

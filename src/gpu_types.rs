@@ -102,6 +102,7 @@ pub struct GpuMaterial {
 /// Material kinds (`GpuMaterial::bsdf_kind`), as `scene::MaterialKind`.
 pub const MATERIAL_METALLIC_ROUGHNESS: u32 = 0;
 pub const MATERIAL_CONDUCTOR: u32 = 1;
+pub const MATERIAL_COATED_DIFFUSE: u32 = 3;
 
 /// One entry of the light table (WGSL `Light`).
 #[repr(C)]

@@ -29,6 +29,7 @@ pub const RENDER_FILES: &[&str] = &[
     "baked_geometry.wgsl",
     "scene_data.wgsl",
     "bsdf_conductor.wgsl",
+    "bsdf_coated_diffuse.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
     "lights.wgsl",

@@ -23,7 +23,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 63;
+const FAMILY: usize = 67;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -1253,6 +1253,37 @@ fn chi2_conductor() {
     run_all("conductor", &conductor_cases());
 }
 
+/// The coated diffuse BSDF's lobe mixture (shaders/bsdf_coated_diffuse.wgsl: the coat's visible normals with
+/// its Fresnel weight, else cosine; η = 1.5 from probe_bsdf), binned over the sphere of wi: a strong and a weak
+/// base, an anisotropic coat, grazing incidence.
+fn coated_cases() -> Vec<Case> {
+    let mut v = Vec::new();
+    for (r, au, av, inc) in
+        [(0.8f32, 0.1f32, 0.1f32, 30.0f64), (0.05, 0.2, 0.2, 60.0), (0.243, 0.1, 0.4, 45.0), (0.5, 0.3, 0.3, 80.0)]
+    {
+        let t = deg(inc);
+        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let mut c = bsdf_case(
+            "coated diffuse (VNDF coat + cosine base)",
+            format!("R = {r}, α_u = {au}, α_v = {av}, θo = {inc}°"),
+            wo,
+            [r, r * 0.5, r * 0.25],
+            0.0,
+            au,
+            0.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [au, 0.0, 3.0, av];
+        v.push(c);
+    }
+    v
+}
+
+#[test]
+fn chi2_coated_diffuse() {
+    run_all("coated diffuse", &coated_cases());
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Environment
 
@@ -1443,6 +1474,7 @@ fn family_size() {
         + light_cases().len()
         + bsdf_cases().len()
         + conductor_cases().len()
+        + coated_cases().len()
         + env_cases().len()
         + 2
         + TREE_POINTS.len();

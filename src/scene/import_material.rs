@@ -59,16 +59,6 @@ pub enum Mapped {
     Invisible,
 }
 
-/// Normal-incidence reflectance of common conductors, linear Rec.709 (the usual published F0 table values),
-/// for pbrt's named `metal-*-eta` / `metal-*-k` spectra.
-const NAMED_METALS: &[(&str, [f32; 3])] = &[
-    ("Ag", [0.972, 0.960, 0.915]),
-    ("Al", [0.913, 0.922, 0.924]),
-    ("Au", [1.000, 0.766, 0.336]),
-    ("Cu", [0.955, 0.638, 0.538]),
-    ("CuZn", [0.910, 0.778, 0.423]),
-];
-
 /// Maps `desc` onto a mislab material, loading its textures into `scene` (through `cache`). Approximations add
 /// one warning each to `warnings`.
 pub fn map(
@@ -90,22 +80,18 @@ pub fn map(
                 warn("a conductor without its coat");
             }
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
-            match (desc.params.get("eta"), desc.params.get("k"), t) {
-                // RGB η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
-                (Some(MatParam::Rgb(eta)), Some(MatParam::Rgb(k)), None)
-                    if desc.params.get("reflectance").is_none() =>
-                {
-                    Material {
-                        kind: MaterialKind::Conductor { eta: *eta, k: *k, alpha_u: au, alpha_v: av },
-                        ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
-                    }
-                }
+            match (conductor_eta_k(desc), t) {
+                // RGB or named η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
+                (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => Material {
+                    kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av },
+                    ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
+                },
                 // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
                 // normal-incidence reflectance, NAMED_METALS): the complex-Fresnel conductor of that F(0).
-                (_, _, None) => {
+                (_, None) => {
                     let f0 = if desc.params.contains_key("reflectance") { c } else { conductor_f0(desc) * c };
-                    if desc.params.contains_key("eta") && desc.params.get("reflectance").is_none() {
-                        warn("a complex-Fresnel conductor with the named metal's normal-incidence reflectance");
+                    if desc.params.get("reflectance").is_none() {
+                        warn("a complex-Fresnel conductor of reflectance 0.9 (a spectrum not in the named-spectra table)");
                     }
                     Material {
                         kind: MaterialKind::conductor_from_reflectance(f0, au, av),
@@ -113,19 +99,13 @@ pub fn map(
                     }
                 }
                 // A textured reflectance: the Fresnel-free GGX conductor, which reads the texture.
-                (_, _, Some(t)) => {
+                (_, Some(t)) => {
                     warn("a Fresnel-free GGX conductor with its textured normal-incidence reflectance");
                     with_texture(Material::conductor(&desc.name, conductor_f0(desc) * c, alpha), Some(t))
                 }
             }
         }
-        "coateddiffuse" | "plastic" | "roughplastic" => {
-            let (c, t) = color(desc, &["reflectance", "diffuse_reflectance"], Vec3::splat(0.5), scene, cache)?;
-            warn("a glTF dielectric (GGX specular with F0 0.04 over Lambert)");
-            let alpha = alpha_of(desc).max(super::ALPHA_MIN);
-            let mat = Material { specular: 1.0, roughness: alpha.sqrt(), ..Material::lambert(&desc.name, c) };
-            with_texture(mat, t)
-        }
+        "coateddiffuse" | "plastic" | "roughplastic" => return coated_diffuse(desc, scene, cache, warnings),
         "diffusetransmission" => {
             let (c, t) = color(desc, &["reflectance"], Vec3::splat(0.25), scene, cache)?;
             warn("Lambert reflection only (its transmission is dropped)");
@@ -145,6 +125,128 @@ pub fn map(
         }
     };
     Ok(Mapped::Material(Box::new(m)))
+}
+
+/// pbrt-v4 `coateddiffuse` and Mitsuba `plastic` / `roughplastic` onto `MaterialKind::CoatedDiffuse` (the analytic
+/// coat-over-Lambert model; docs/materials.md measures it against pbrt's stochastic layered evaluation).
+fn coated_diffuse(
+    desc: &MaterialDesc,
+    scene: &mut Scene,
+    cache: &mut TextureCache,
+    warnings: &mut Vec<String>,
+) -> Result<Mapped, SceneError> {
+    let mut warn = |what: &str| warnings.push(format!("material {} ({}): {what}", desc.name, desc.kind));
+    let f = |n: &str| match desc.params.get(n) {
+        Some(MatParam::Float(v)) => Some(*v),
+        Some(MatParam::Rgb(c)) => Some(c.x),
+        _ => None,
+    };
+    let pbrt = desc.kind == "coateddiffuse";
+    let (mut c, t) = color(desc, &["reflectance", "diffuse_reflectance"], Vec3::splat(0.5), scene, cache)?;
+    // Smooth (Mitsuba `plastic`, pbrt roughness 0) is α = 0, which the GPU clamps to ALPHA_MIN.
+    let alpha = if desc.kind == "plastic" { 0.0 } else { alpha_of(desc) };
+    let alpha = if desc.kind == "roughplastic" && !desc.params.contains_key("alpha") && alpha_uv(desc).is_none() {
+        0.1 // Mitsuba's default
+    } else {
+        alpha
+    };
+    let (au, av) = if desc.kind == "plastic" { (0.0, 0.0) } else { alpha_uv(desc).unwrap_or((alpha, alpha)) };
+    let eta = if pbrt {
+        match desc.params.get("eta") {
+            None => 1.5,
+            Some(MatParam::Float(e)) => *e,
+            Some(MatParam::Rgb(e)) => e.x,
+            Some(other) => {
+                warn(&format!("eta {other:?} is not a number; the coat uses η = 1.5"));
+                1.5
+            }
+        }
+    } else {
+        mitsuba_ior(desc, "int_ior", 1.49, &mut warn) / mitsuba_ior(desc, "ext_ior", 1.000277, &mut warn)
+    };
+    let eta = if eta > 1.0 && eta.is_finite() {
+        eta
+    } else {
+        warn(&format!("a coat of relative η = {eta} (the model needs η > 1) rendered with η = 1.5"));
+        1.5
+    };
+    if pbrt {
+        // pbrt's medium between coat and base: the analytic model has none (thickness 0.01 with albedo 0 only
+        // absorbs exp(−0.01/cosθ) per crossing in pbrt; the table in docs/materials.md includes it).
+        let medium = f("albedo").is_some_and(|a| a != 0.0)
+            || desc.params.get("albedo").is_some_and(|a| !matches!(a, MatParam::Float(_) | MatParam::Rgb(_)))
+            || f("g").is_some_and(|g| g != 0.0)
+            || f("thickness").is_some_and(|d| (d - 0.01).abs() > 1e-6);
+        if medium {
+            warn("its layer medium (thickness/albedo/g) is ignored: the analytic coat has no medium");
+        }
+    } else {
+        if !matches!(desc.params.get("nonlinear"), Some(MatParam::Bool(true))) {
+            // Mitsuba's default linear form: its reflectance is the base's share; converted exactly for colours.
+            let fi = super::coated::coated_internal_reflectance(eta);
+            let lin = |r: f32| super::coated::reflectance_from_linear(r, fi);
+            c = Vec3::new(lin(c.x), lin(c.y), lin(c.z));
+            if t.is_some() {
+                warn("Mitsuba's linear (nonlinear = false) reflectance of a texture converted at the texture factor");
+            }
+        }
+        if desc.kind == "roughplastic"
+            && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx")
+        {
+            warn("a Beckmann coat rendered as GGX of the same α");
+        }
+        if f("specular_reflectance").is_some_and(|s| s != 1.0) {
+            warn("specular_reflectance other than 1 is ignored");
+        }
+    }
+    let m = Material {
+        kind: MaterialKind::CoatedDiffuse { eta, alpha_u: au, alpha_v: av },
+        ..Material::coated_diffuse(&desc.name, c, eta, au)
+    };
+    Ok(Mapped::Material(Box::new(with_texture(m, t))))
+}
+
+/// A Mitsuba index of refraction: a number, or one of the names of Mitsuba's IOR table (its common entries).
+fn mitsuba_ior(desc: &MaterialDesc, name: &str, default: f32, warn: &mut impl FnMut(&str)) -> f32 {
+    const NAMED: &[(&str, f32)] = &[
+        ("vacuum", 1.0),
+        ("helium", 1.000036),
+        ("hydrogen", 1.000132),
+        ("air", 1.000277),
+        ("carbon dioxide", 1.00045),
+        ("water", 1.3330),
+        ("acetone", 1.36),
+        ("ethanol", 1.361),
+        ("carbon tetrachloride", 1.461),
+        ("glycerol", 1.4729),
+        ("benzene", 1.501),
+        ("silicone oil", 1.52045),
+        ("bromine", 1.661),
+        ("water ice", 1.31),
+        ("fused quartz", 1.458),
+        ("pyrex", 1.470),
+        ("acrylic glass", 1.49),
+        ("polypropylene", 1.49),
+        ("bk7", 1.5046),
+        ("sodium chloride", 1.544),
+        ("amber", 1.55),
+        ("pet", 1.5750),
+        ("diamond", 2.419),
+    ];
+    match desc.params.get(name) {
+        None => default,
+        Some(MatParam::Float(v)) => *v,
+        Some(MatParam::Str(s)) => {
+            NAMED.iter().find(|(n, _)| n.eq_ignore_ascii_case(s)).map(|(_, v)| *v).unwrap_or_else(|| {
+                warn(&format!("unknown {name} \"{s}\"; {default} used"));
+                default
+            })
+        }
+        Some(other) => {
+            warn(&format!("{name} {other:?} is not a number; {default} used"));
+            default
+        }
+    }
 }
 
 fn with_texture(mut m: Material, t: Option<TextureRef>) -> Material {
@@ -215,22 +317,32 @@ fn alpha_uv(desc: &MaterialDesc) -> Option<(f32, f32)> {
     Some(if remap { (u.sqrt(), v.sqrt()) } else { (u, v) })
 }
 
-/// Normal-incidence Fresnel reflectance from `eta` / `k` (RGB or a named metal); Cu, pbrt's default, if absent.
-fn conductor_f0(desc: &MaterialDesc) -> Vec3 {
-    let named = |s: &str| {
-        let metal = s.trim_start_matches("metal-").split('-').next().unwrap_or("");
-        NAMED_METALS.iter().find(|(n, _)| *n == metal).map(|(_, c)| Vec3::from_array(*c))
+/// RGB η and k of a conductor: RGB values, pbrt's named spectra (`metal-Au-eta`; super::named_spectra), Mitsuba's
+/// `material` name, or pbrt's default (copper) when neither is given. None when a name is not in the table.
+fn conductor_eta_k(desc: &MaterialDesc) -> Option<(Vec3, Vec3)> {
+    use super::named_spectra::{lookup, Part};
+    let get = |name: &str, part: Part| match desc.params.get(name) {
+        Some(MatParam::Rgb(c)) => Some(*c),
+        Some(MatParam::Float(f)) => Some(Vec3::splat(*f)),
+        Some(MatParam::Spectrum(s)) => lookup(s, part),
+        None => None,
+        _ => None,
     };
-    match (desc.params.get("eta"), desc.params.get("k")) {
-        (Some(MatParam::Rgb(eta)), Some(MatParam::Rgb(k))) => {
-            let f = |n: f32, k: f32| ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
-            Vec3::new(f(eta.x, k.x), f(eta.y, k.y), f(eta.z, k.z))
+    if let Some(MatParam::Str(m)) = desc.params.get("material") {
+        if desc.params.get("eta").is_none() && desc.params.get("k").is_none() {
+            return Some((lookup(&format!("metal-{m}-eta"), Part::Eta)?, lookup(&format!("metal-{m}-k"), Part::K)?));
         }
-        (Some(MatParam::Spectrum(s)), _) => named(s).unwrap_or(Vec3::splat(0.9)),
-        (None, None) if desc.params.contains_key("material") => Vec3::splat(0.9),
-        (None, None) => Vec3::from_array(NAMED_METALS[3].1),
-        _ => Vec3::splat(0.9),
     }
+    let absent = |n: &str| !desc.params.contains_key(n);
+    let eta = if absent("eta") { lookup("metal-Cu-eta", Part::Eta) } else { get("eta", Part::Eta) }?;
+    let k = if absent("k") { lookup("metal-Cu-k", Part::K) } else { get("k", Part::K) }?;
+    Some((eta, k))
+}
+
+/// Normal-incidence Fresnel reflectance of the conductor's η / k (copper's if absent); 0.9 for names not in the
+/// table.
+fn conductor_f0(desc: &MaterialDesc) -> Vec3 {
+    conductor_eta_k(desc).map_or(Vec3::splat(0.9), |(eta, k)| super::named_spectra::f0(eta, k))
 }
 
 #[cfg(test)]
@@ -275,10 +387,20 @@ mod tests {
             other => panic!("conductor mapped to {other:?}"),
         }
         assert!(w.is_empty(), "{w:?}");
-        // A named metal: its normal-incidence reflectance as a complex-Fresnel conductor, with a warning.
-        let d = desc("conductor", vec![("eta", MatParam::Spectrum("metal-Au-eta".into()))]);
+        // A named metal: its RGB η and k from the named-spectra table, exactly, without a warning.
+        let d = desc(
+            "conductor",
+            vec![("eta", MatParam::Spectrum("metal-Au-eta".into())), ("k", MatParam::Spectrum("metal-Au-k".into()))],
+        );
         let Mapped::Material(m) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
-        assert!(matches!(m.kind, MaterialKind::Conductor { .. }));
-        assert_eq!(w.len(), 1);
+        let au = |p| crate::scene::named_spectra::lookup(p, crate::scene::named_spectra::Part::Eta);
+        assert!(matches!(m.kind, MaterialKind::Conductor { eta, .. } if Some(eta) == au("metal-Au-eta")));
+        assert!(w.is_empty(), "{w:?}");
+        // pbrt's default conductor is copper; an unknown spectrum name is approximated with a warning.
+        let Mapped::Material(m) = map(&desc("conductor", vec![]), &mut s, &mut c, &mut w).unwrap() else { panic!() };
+        assert!(matches!(m.kind, MaterialKind::Conductor { k, .. } if k.x > 3.0 && k.z < 2.5), "{:?}", m.kind);
+        let d = desc("conductor", vec![("eta", MatParam::Spectrum("metal-Xx-eta".into()))]);
+        let Mapped::Material(_) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
+        assert_eq!(w.len(), 1, "{w:?}");
     }
 }

@@ -2,6 +2,7 @@
 //! downstream (BVH, GPU upload, features) consumes. World space, right-handed, +Y up, linear Rec.709 RGB.
 
 pub mod builtin;
+pub mod coated;
 pub mod env_import;
 pub mod envmap;
 pub mod gltf;
@@ -10,6 +11,7 @@ pub mod import_material;
 pub mod import_texture;
 pub mod many_lights;
 pub mod mitsuba;
+pub mod named_spectra;
 pub mod obj;
 pub mod pbrt;
 pub mod pfm;
@@ -161,6 +163,18 @@ pub enum MaterialKind {
         /// GGX α along the bitangent.
         alpha_v: f32,
     },
+    /// A rough dielectric coat of relative index `eta` over a Lambertian base (pbrt-v4 `coateddiffuse`, Mitsuba
+    /// `plastic`/`roughplastic`; shaders/bsdf_coated_diffuse.wgsl). The base's reflectance is the material's
+    /// `base_color` times `base_color_texture` (one source for both, as the GPU reads it); the coat is anisotropic
+    /// GGX of α `alpha_u` / `alpha_v` (clamped to `ALPHA_MIN`).
+    CoatedDiffuse {
+        /// Index of refraction of the coat relative to the outside (> 1).
+        eta: f32,
+        /// GGX α along the tangent.
+        alpha_u: f32,
+        /// GGX α along the bitangent.
+        alpha_v: f32,
+    },
 }
 
 impl MaterialKind {
@@ -231,6 +245,16 @@ impl Material {
             base_color: reflectance,
             metallic: 1.0,
             roughness: alpha.max(0.0).sqrt(),
+            ..Default::default()
+        }
+    }
+    /// A coated diffuse material: a GGX dielectric coat (relative index `eta`, isotropic α) over a Lambertian
+    /// base of the given reflectance.
+    pub fn coated_diffuse(name: &str, reflectance: Vec3, eta: f32, alpha: f32) -> Self {
+        Material {
+            name: name.into(),
+            kind: MaterialKind::CoatedDiffuse { eta, alpha_u: alpha, alpha_v: alpha },
+            base_color: reflectance,
             ..Default::default()
         }
     }

@@ -449,10 +449,11 @@ fn material(
         "lambert" => &["reflectance", "emission"],
         "conductor" => &["reflectance", "alpha", "emission", "eta", "k", "alpha_u", "alpha_v"],
         "metallic-roughness" => &["base_color", "metallic", "roughness", "specular", "emission"],
+        "coated-diffuse" => &["reflectance", "eta", "alpha", "alpha_u", "alpha_v", "emission"],
         "emitter" => &["emission"],
         other => {
             return Err(e(&format!(
-                "unknown type \"{other}\" (expected lambert, conductor, metallic-roughness or emitter)"
+                "unknown type \"{other}\" (expected lambert, conductor, metallic-roughness, coated-diffuse or emitter)"
             )))
         }
     };
@@ -508,6 +509,24 @@ fn material(
                 0.0,
             )?;
             Material::conductor(name, color("reflectance", d.reflectance, 1.0)?, alpha)
+        }
+        "coated-diffuse" => {
+            // MaterialKind::CoatedDiffuse: η one number (the coat is not dispersive), α once or per axis.
+            let eta = Vec3::from(d.eta.map(|s| s.0).unwrap_or([1.5; 3]));
+            if eta.x != eta.y || eta.x != eta.z || !(eta.x > 1.0 && eta.x.is_finite()) {
+                return Err(e("a coated-diffuse 'eta' must be one finite number > 1"));
+            }
+            let a = match (d.alpha, d.alpha_u, d.alpha_v) {
+                (Some(a), None, None) => (a, a),
+                (None, Some(u), Some(v)) => (u, v),
+                _ => return Err(e("type \"coated-diffuse\" needs 'alpha', or both 'alpha_u' and 'alpha_v'")),
+            };
+            let (alpha_u, alpha_v) = (unit("alpha_u", Some(a.0), 0.0)?, unit("alpha_v", Some(a.1), 0.0)?);
+            let reflectance = color("reflectance", d.reflectance, 0.5)?;
+            Material {
+                kind: MaterialKind::CoatedDiffuse { eta: eta.x, alpha_u, alpha_v },
+                ..Material::coated_diffuse(name, reflectance, eta.x, alpha_u)
+            }
         }
         "metallic-roughness" => Material {
             name: name.into(),
