@@ -45,6 +45,10 @@ pub struct Features {
     pub diffuse: bool,
     /// Any `MaterialKind::Conductor` (shaders/bsdf_conductor.wgsl).
     pub conductor: bool,
+    /// Any `MaterialKind::Dielectric` (shaders/bsdf_dielectric.wgsl).
+    pub dielectric: bool,
+    /// Any `MaterialKind::DiffuseTransmission` (shaders/bsdf_diffuse_transmission.wgsl).
+    pub diffuse_transmission: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
     /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
@@ -81,6 +85,8 @@ impl Features {
             specular: true,
             diffuse: true,
             conductor: true,
+            dielectric: true,
+            diffuse_transmission: true,
             many_lights: true,
             flat: None,
             baked: 0,
@@ -110,6 +116,8 @@ impl Features {
             specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
+            dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
+            diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
             many_lights: data.lights.len() > 1,
             flat: flat_counts(data),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {
@@ -137,6 +145,8 @@ impl Features {
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("HAS_CONDUCTOR", b(self.conductor)),
+            ("HAS_DIELECTRIC", b(self.dielectric)),
+            ("HAS_DIFFUSE_TRANSMISSION", b(self.diffuse_transmission)),
             ("MANY_LIGHTS", b(self.many_lights)),
             ("FLAT_SCENE", b(self.flat.is_some())),
         ]
@@ -161,6 +171,8 @@ impl Features {
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);
+        on("dielectric (Fresnel reflection and refraction)", self.dielectric);
+        on("diffuse transmission", self.diffuse_transmission);
         on("light selection", self.many_lights);
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));

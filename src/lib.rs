@@ -25,6 +25,7 @@ pub mod output_file;
 pub mod pipeline_cache;
 pub mod probe;
 pub mod progressive;
+pub mod reachability;
 pub mod reference;
 pub mod render;
 pub mod sampler_figure;

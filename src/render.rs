@@ -27,6 +27,8 @@ pub const RENDER_FILES: &[&str] = &[
     "baked_geometry.wgsl",
     "scene_data.wgsl",
     "bsdf_conductor.wgsl",
+    "bsdf_dielectric.wgsl",
+    "bsdf_diffuse_transmission.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
     "lights.wgsl",

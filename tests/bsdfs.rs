@@ -5,7 +5,7 @@
 mod common;
 
 use mislab::scene::{self, Environment, LoadOptions, MaterialKind};
-use mislab::settings::{Settings, Strategy};
+use mislab::settings::{Mode, Settings, Strategy};
 
 /// A row of conductors in a white furnace (constant radiance 1, nothing else): k = 10⁴ makes F ≈ 1, so each
 /// sphere's pixels are the directional albedo of its single-scattering GGX surface (a convex sphere sees only the
@@ -125,6 +125,80 @@ fn conductor_white_furnace() {
         } else {
             // Gold: red above blue (its Fresnel), and below 1.
             assert!(mean[0] > mean[2] && mean[0] < 1.0, "gold: {mean:?}");
+        }
+    }
+}
+
+/// Mean of a 4×4 block of pixels around the centre of the sphere at x = cx (camera at z = 9, vfov 20°).
+fn sphere_mean(film: &mislab::film::Film, w: u32, h: u32, cx: f32) -> [f64; 3] {
+    let px = (w as f32 * 0.5 + cx / (9.0 * 10f32.to_radians().tan()) * h as f32 * 0.5) as i32;
+    let mut sum = [0f64; 3];
+    let mut n = 0.0;
+    for y in (h as i32 / 2 - 2)..(h as i32 / 2 + 2) {
+        for x in (px - 2)..(px + 2) {
+            let m = film.mean[(y as u32 * w + x as u32) as usize];
+            for c in 0..3 {
+                sum[c] += m[c] as f64;
+            }
+            n += 1.0;
+        }
+    }
+    sum.map(|v| v / n)
+}
+
+const GLASS_FURNACE: &str = r#"
+[camera]
+position = [0, 0, 9]
+look_at = [0, 0, 0]
+vfov = 20
+
+[materials.glass]
+type = "dielectric"
+eta = 1.5
+
+[materials.rough]
+type = "dielectric"
+eta = 1.5
+alpha = 0.3
+
+[materials.leaf]
+type = "diffuse-transmission"
+reflectance = 0.4
+transmittance = 0.6
+
+[[sphere]]
+center = [-1.1, 0, 0]
+radius = 0.5
+material = "glass"
+
+[[sphere]]
+center = [0, 0, 0]
+radius = 0.5
+material = "rough"
+
+[[sphere]]
+center = [1.1, 0, 0]
+radius = 0.5
+material = "leaf"
+
+[environment]
+constant = 1
+"#;
+
+#[test]
+fn dielectric_white_furnace() {
+    let ctx = common::gpu();
+    let s = load(GLASS_FURNACE, "furnace-glass.toml");
+    let (w, h) = (96u32, 32u32);
+    for (strategy, max_depth) in
+        [(Strategy::Bsdf, 1), (Strategy::Bsdf, 2), (Strategy::Bsdf, 3), (Strategy::Bsdf, 32), (Strategy::Mis, 32)]
+    {
+        let settings = Settings { max_depth, strategy, mode: Mode::Path, ..common::small(w, h) };
+        let film = common::render(&ctx, &s, &settings, 64);
+        let bad: u32 = film.nonfinite.iter().sum();
+        assert_eq!(bad, 0, "NaN/Inf samples");
+        for cx in [-1.1f32, 0.0, 1.1] {
+            eprintln!("{strategy:?} {max_depth} sphere at {cx}: {:?}", sphere_mean(&film, w, h, cx));
         }
     }
 }
