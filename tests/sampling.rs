@@ -152,6 +152,7 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             let s = bsdf_sample(probe_bsdf(), p, u.z, u.xy);
             o0 = vec4<f32>(s.wi, s.pdf);
             if (s.pdf > 0.0) { o1.x = bsdf_pdf(probe_bsdf(), p, s.wi); }
+            o1.z = s.f.x;    // f of the sample (red), for the f / eval consistency test
         }
         case R_ENV: {
             let s = env_sample(u.xyz);
@@ -194,7 +195,12 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         case R_LIGHT: {
             if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, light_measure(probe_job.light, probe_job.p.xyz), probe_job.p.xyz, w.xyz, y, probe_light_normal(probe_job.light, y)); }
         }
-        case R_BSDF: { pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz); }
+        case R_BSDF: {
+            pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz);
+            // f(wo, w) and f(w, wo) (red), for the reciprocity test.
+            probe_out[i] = vec4<f32>(pdf, bsdf_eval(probe_bsdf(), probe_job.p.xyz, w.xyz).x, bsdf_eval(probe_bsdf(), w.xyz, probe_job.p.xyz).x, 0.0);
+            return;
+        }
         case R_ENV: { pdf = env_pdf(w.xyz); }
         case R_SELECT: { pdf = light_pmf(u32(w.x), probe_job.p.xyz, probe_job.a.xyz); }
         default: {}
@@ -1317,6 +1323,50 @@ fn diffuse_transmission_cases() -> Vec<Case> {
 #[test]
 fn chi2_diffuse_transmission() {
     run_all("diffuse-transmission", &diffuse_transmission_cases());
+}
+
+/// Reciprocity and sample/eval consistency of the rough dielectric and diffuse transmission on the device: the f a
+/// sample returns is bsdf_eval at its direction; reflection is symmetric, f(wo, wi) = f(wi, wo); and the
+/// dielectric's transmission obeys f(wi, wo) = η'²·f(wo, wi) (η' = η from above: Veach 1997, eq. 5.14, with the
+/// 1/η'² radiance scaling), diffuse transmission's f(wi, wo) = f(wo, wi).
+#[test]
+fn bsdf_reciprocity() {
+    let h = harness();
+    let count = 1u32 << 12;
+    let mut checked = 0;
+    for (kind, eta) in
+        [(MATERIAL_DIELECTRIC, 1.5f32), (MATERIAL_DIELECTRIC, 1.0 / 1.33), (MATERIAL_DIFFUSE_TRANSMISSION, 0.0)]
+    {
+        let wo = DVec3::new(0.5, 0.3, 0.8).normalize();
+        let mut s = Setup::new(SceneId::Lights, R_BSDF);
+        s.job.p = v4(wo, eta as f64);
+        s.job.a = [0.35, 0.0, kind as f32, 0.2];
+        s.job.b = [0.7, 0.7, 0.7, 0.3];
+        let out = h.sample(&s, count, 0, 1, 11);
+        let inputs: Vec<[[f32; 4]; 2]> = out.iter().map(|[a, _]| [[a[0], a[1], a[2], 1.0], [0.0; 4]]).collect();
+        let job = ProbeJob { count, ..s.job };
+        let flat: Vec<[f32; 4]> = inputs.iter().flatten().copied().collect();
+        let evals = h.dispatch(true, s.scene, &s.frame, &job, &flat, count as usize);
+        for ([a, b], e) in out.iter().zip(&evals) {
+            if !(a[3] > 0.0) {
+                continue;
+            }
+            let (f_sample, f_fwd, f_rev) = (b[2] as f64, e[1] as f64, e[2] as f64);
+            assert!(
+                (f_sample - f_fwd).abs() <= 1e-4 * f_fwd.abs() + 1e-7,
+                "kind {kind}: sample f {f_sample} vs eval {f_fwd}"
+            );
+            let transmitted = a[2] < 0.0;
+            let ratio = if transmitted && kind == MATERIAL_DIELECTRIC { (eta * eta) as f64 } else { 1.0 };
+            assert!(
+                (f_rev - ratio * f_fwd).abs() <= 2e-3 * f_rev.abs().max(ratio * f_fwd.abs()) + 1e-6,
+                "kind {kind}, η {eta}, wi {a:?}: f(wi, wo) {f_rev} vs {ratio}·f(wo, wi) {}",
+                ratio * f_fwd
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 3 * count as usize / 2, "too few valid samples ({checked})");
 }
 
 /// Unpolarised Fresnel reflectance of a dielectric (CPU reference, f64): cosine c of incidence on the side the
