@@ -388,4 +388,62 @@ mod tests {
         assert!(matches!(m.kind, MaterialKind::Conductor { .. }));
         assert_eq!(w.len(), 1);
     }
+
+    #[test]
+    fn dielectric_and_diffuse_transmission() {
+        let mut s = Scene::default();
+        let mut c = TextureCache::default();
+        let mut w = vec![];
+        let kind = |d: &MaterialDesc, s: &mut Scene, c: &mut TextureCache, w: &mut Vec<String>| match map(d, s, c, w)
+            .unwrap()
+        {
+            Mapped::Material(m) => m.kind,
+            Mapped::Invisible => panic!("{} left out", d.kind),
+        };
+        // pbrt: eta and a remapped roughness (√0.04 = 0.2); remaproughness false keeps it.
+        let d = desc("dielectric", vec![("eta", MatParam::Float(1.33)), ("roughness", MatParam::Float(0.04))]);
+        assert_eq!(
+            kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { eta: 1.33, alpha_u: 0.2, alpha_v: 0.2, tint: Vec3::ONE, thin: false }
+        );
+        let d = desc(
+            "dielectric",
+            vec![
+                ("uroughness", MatParam::Float(0.1)),
+                ("vroughness", MatParam::Float(0.3)),
+                ("remaproughness", MatParam::Bool(false)),
+            ],
+        );
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { eta, alpha_u, alpha_v, .. } if eta == 1.5 && alpha_u == 0.1 && alpha_v == 0.3));
+        assert!(w.is_empty(), "{w:?}");
+        // A named glass: its index at ~550 nm.
+        let d = desc("dielectric", vec![("eta", MatParam::Spectrum("glass-BK7".into()))]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { eta, .. } if eta == 1.5168));
+        // Mitsuba: int_ior / ext_ior by name or number; roughdielectric defaults to α = 0.1; thin is smooth.
+        let d = desc("dielectric", vec![("int_ior", MatParam::Str("water".into())), ("ext_ior", MatParam::Float(1.0))]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { eta, .. } if eta == 1.333));
+        let d = desc("roughdielectric", vec![]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { alpha_u, thin: false, .. } if alpha_u == 0.1));
+        let d = desc("thindielectric", vec![]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { thin: true, alpha_u, .. } if alpha_u == 0.0));
+        assert!(w.is_empty(), "{w:?}");
+        // pbrt's diffusetransmission: reflectance and transmittance × scale.
+        let d = desc(
+            "diffusetransmission",
+            vec![("transmittance", MatParam::Rgb(Vec3::new(0.2, 0.4, 0.6))), ("scale", MatParam::Float(0.5))],
+        );
+        assert_eq!(
+            kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::DiffuseTransmission {
+                reflectance: Vec3::splat(0.125),
+                transmittance: Vec3::new(0.1, 0.2, 0.3),
+                transmittance_textured: false
+            }
+        );
+        // Interfaces between media stay left out.
+        assert!(matches!(map(&desc("interface", vec![]), &mut s, &mut c, &mut w).unwrap(), Mapped::Invisible));
+    }
 }
