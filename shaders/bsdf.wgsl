@@ -23,10 +23,26 @@ struct BsdfParams {
 }
 
 /// A sampled direction: wi (local), the pdf of the sampling technique (solid angle), and f (no cosine).
+/// `delta`: wi is a delta lobe's (smooth glass, mirror) — pdf is then the lobe's discrete probability, f·|cosθi|/pdf
+/// the sample's weight, and neither bsdf_eval nor bsdf_pdf sees the lobe (its density is "infinite").
 struct BsdfSample {
     wi: vec3<f32>,
     pdf: f32,
     f: vec3<f32>,
+    delta: bool,
+}
+
+/// Whether the material is delta lobes only (light sampling cannot contribute: estimators.wgsl skips it).
+fn bsdf_is_delta(p: BsdfParams) -> bool {
+    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_is_smooth(p); }
+    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return max(p.alpha, p.alpha_v) < DELTA_ALPHA; }
+    return false;
+}
+
+/// Whether the material transmits (wi below the surface is allowed: two-sided light sampling, |cos|).
+fn bsdf_transmits(p: BsdfParams) -> bool {
+    return (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC)
+        || (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION);
 }
 
 /// GGX normal distribution D(h), h local. Measure: projected solid angle of microfacet normals.
@@ -95,6 +111,10 @@ fn bsdf_specular_probability(p: BsdfParams, wo: vec3<f32>) -> f32 {
 fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_eval(p, wo, wi); }
     if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_eval(p, wo, wi); }
+    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_eval(p, wo, wi); }
+    if (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION) {
+        return diffuse_transmission_eval(p, wo, wi);
+    }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return vec3<f32>(0.0); }
     let h = normalize(wo + wi);
     let fw = schlick_weight(dot(wo, h));
@@ -114,6 +134,10 @@ fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_pdf(p, wo, wi); }
     if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_pdf(p, wo, wi); }
+    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_pdf(p, wo, wi); }
+    if (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION) {
+        return diffuse_transmission_pdf(p, wo, wi);
+    }
     if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
     let ps = bsdf_specular_probability(p, wo);
     var pdf = (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
@@ -126,9 +150,14 @@ fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 fn bsdf_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
     if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_sample(p, wo, u); }
     if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_sample(p, wo, u_lobe, u); }
+    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_sample(p, wo, u_lobe, u); }
+    if (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION) {
+        return diffuse_transmission_sample(p, wo, u_lobe, u);
+    }
     var s: BsdfSample;
     s.pdf = 0.0;
     s.f = vec3<f32>(0.0);
+    s.delta = false;
     if (wo.z <= 0.0) { return s; }
     let ps = bsdf_specular_probability(p, wo);
     if (HAS_SPECULAR && u_lobe < ps) {

@@ -7,6 +7,7 @@
 //   G2: height-correlated Smith; F: the unpolarised Fresnel reflectance of a conductor (pbrt-v4 FrComplex).
 // Sampling: visible normals (Heitz 2018) by stretching wo into the isotropic configuration and sampling the
 // spherical cap there (Dupuy & Benyoub 2023, as bsdf.wgsl), then un-stretching. pdf(wi) = G1(wo)·D(h)/(4 wo.z).
+// Smooth (max α < DELTA_ALPHA): an exact mirror, a delta lobe that only conductor_sample reaches (eval, pdf 0).
 // Reached only where the scene has a conductor (HAS_CONDUCTOR, src/features.rs).
 
 /// Anisotropic GGX D(h). Written as the isotropic ggx_d with the stretched slope, without 1 − cos²θ.
@@ -69,7 +70,7 @@ fn fresnel_complex3(c: f32, eta: vec3<f32>, k: vec3<f32>) -> vec3<f32> {
 
 /// f_r(wo, wi) without the cosine. Zero below either hemisphere.
 fn conductor_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    if (wo.z <= 0.0 || wi.z <= 0.0) { return vec3<f32>(0.0); }
+    if (wo.z <= 0.0 || wi.z <= 0.0 || max(p.alpha, p.alpha_v) < DELTA_ALPHA) { return vec3<f32>(0.0); }
     let h = normalize(wo + wi);
     let au = p.alpha;
     let av = p.alpha_v;
@@ -80,7 +81,7 @@ fn conductor_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 
 /// pdf (solid angle) of conductor_sample producing wi: G1(wo)·D(h)/(4 wo.z).
 fn conductor_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
+    if (wo.z <= 0.0 || wi.z <= 0.0 || max(p.alpha, p.alpha_v) < DELTA_ALPHA) { return 0.0; }
     let h = normalize(wo + wi);
     return aniso_ggx_g1(wo, p.alpha, p.alpha_v) * aniso_ggx_d(h, p.alpha, p.alpha_v) / (4.0 * wo.z);
 }
@@ -90,7 +91,16 @@ fn conductor_sample(p: BsdfParams, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     var s: BsdfSample;
     s.pdf = 0.0;
     s.f = vec3<f32>(0.0);
+    s.delta = false;
     if (wo.z <= 0.0) { return s; }
+    if (max(p.alpha, p.alpha_v) < DELTA_ALPHA) {
+        // The mirror: weight F(cosθo), as f·cos/pdf with pdf 1.
+        s.wi = vec3<f32>(-wo.x, -wo.y, wo.z);
+        s.pdf = 1.0;
+        s.delta = true;
+        s.f = fresnel_complex3(wo.z, p.eta, p.k) / wo.z;
+        return s;
+    }
     let h = aniso_ggx_sample_visible_normal(wo, p.alpha, p.alpha_v, u);
     s.wi = reflect(-wo, h);
     if (s.wi.z <= 0.0) { return s; }

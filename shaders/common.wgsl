@@ -125,6 +125,10 @@ struct Material {
 const MATERIAL_METALLIC_ROUGHNESS: u32 = 0u;
 const MATERIAL_CONDUCTOR: u32 = 1u;
 const MATERIAL_COATED_DIFFUSE: u32 = 3u;
+const MATERIAL_DIELECTRIC: u32 = 2u;              // eta.x = η, alpha/alpha_v, base_color = tint
+const MATERIAL_DIFFUSE_TRANSMISSION: u32 = 4u;    // base_color = reflectance (× base_tex), k = transmittance
+/// GGX α below which conductors and dielectrics are delta lobes (scene::DELTA_ALPHA).
+const DELTA_ALPHA: f32 = 1e-3;
 
 /// One entry of the light table. For area lights `prim` indexes triangles/spheres/quads; for
 /// punctual lights `position`/`direction` are used. `pmf` is this light's selection probability under
@@ -275,6 +279,10 @@ override HAS_SPECULAR: bool = true;
 override HAS_CONDUCTOR: bool = true;
 /// Any MaterialKind::CoatedDiffuse (bsdf_coated_diffuse.wgsl).
 override HAS_COATED_DIFFUSE: bool = true;
+/// Any MaterialKind::Dielectric (bsdf_dielectric.wgsl).
+override HAS_DIELECTRIC: bool = true;
+/// Any MaterialKind::DiffuseTransmission (bsdf_diffuse_transmission.wgsl).
+override HAS_DIFFUSE_TRANSMISSION: bool = true;
 /// Whether any material has a diffuse lobe.
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.

@@ -23,6 +23,10 @@ fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32)
     c.frame = frame_from_normal(x.ns);
     c.wo = to_local(c.frame, -d);
     c.brdf = material_bsdf(m, x.uv);
+    // A dielectric's η is inside over outside; a ray arriving from inside (the back face) sees 1/η.
+    if (HAS_DIELECTRIC && c.brdf.bsdf_kind == MATERIAL_DIELECTRIC && !x.front && c.brdf.eta.y == 0.0) {
+        c.brdf.eta.x = 1.0 / c.brdf.eta.x;
+    }
     c.id = id;
     c.bounce = bounce;
     return c;
@@ -30,39 +34,58 @@ fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32)
 
 // ---- direction techniques ----
 
-/// The direction technique a strategy uses: uniform, cosine, or the BSDF (also for light / mis).
-fn direction_technique() -> u32 {
+/// The direction technique a strategy uses at c: uniform, cosine, or the BSDF (also for light / mis). Surfaces
+/// that transmit or have delta lobes always use the BSDF: the hemisphere techniques cannot reach those directions.
+fn direction_technique(c: ShadingCtx) -> u32 {
+    if (bsdf_transmits(c.brdf) || bsdf_is_delta(c.brdf)) { return STRATEGY_BSDF; }
     if (cfg_strategy() == STRATEGY_UNIFORM || cfg_strategy() == STRATEGY_COSINE) { return cfg_strategy(); }
     return STRATEGY_BSDF;
 }
 
+/// Whether world direction w (local wi) leaves c on a side its BSDF does not allow: a reflection must leave
+/// above the geometric surface and a transmission below it (a shading normal must not leak light through).
+fn wrong_side(c: ShadingCtx, w: vec3<f32>, wi: vec3<f32>) -> bool {
+    if (bsdf_transmits(c.brdf)) { return (dot(w, c.x.ng) > 0.0) != (wi.z > 0.0) || wi.z == 0.0; }
+    return dot(w, c.x.ng) <= 0.0;
+}
+
 /// pdf (solid angle) of the direction technique producing local direction wi.
 fn direction_pdf(c: ShadingCtx, wi: vec3<f32>) -> f32 {
-    switch (direction_technique()) {
+    switch (direction_technique(c)) {
         case STRATEGY_UNIFORM: { return square_to_uniform_hemisphere_pdf(wi); }
         case STRATEGY_COSINE: { return square_to_cosine_hemisphere_pdf(wi); }
         default: { return bsdf_pdf(c.brdf, c.wo, wi); }
     }
 }
 
-/// Samples the direction technique: local wi and its pdf (0 = failed).
-fn direction_sample(c: ShadingCtx, j: u32) -> vec4<f32> {
+/// Samples the direction technique: local wi and its pdf (0 = failed). f is set (and meant) only for a delta
+/// sample (`delta`): the others take bsdf_eval at wi.
+fn direction_sample(c: ShadingCtx, j: u32) -> BsdfSample {
     let base = dim_base(c.bounce, j);
     let u = sample_2d(c.id, base + DIM_BSDF_UV);
-    switch (direction_technique()) {
+    var s: BsdfSample;
+    s.f = vec3<f32>(0.0);
+    s.delta = false;
+    switch (direction_technique(c)) {
         case STRATEGY_UNIFORM: {
-            let w = square_to_uniform_hemisphere(u);
-            return vec4<f32>(w, square_to_uniform_hemisphere_pdf(w));
+            s.wi = square_to_uniform_hemisphere(u);
+            s.pdf = square_to_uniform_hemisphere_pdf(s.wi);
         }
         case STRATEGY_COSINE: {
-            let w = square_to_cosine_hemisphere(u);
-            return vec4<f32>(w, square_to_cosine_hemisphere_pdf(w));
+            s.wi = square_to_cosine_hemisphere(u);
+            s.pdf = square_to_cosine_hemisphere_pdf(s.wi);
         }
         default: {
-            let s = bsdf_sample(c.brdf, c.wo, sample_1d(c.id, base + DIM_BSDF_LOBE), u);
-            return vec4<f32>(s.wi, s.pdf);
+            s = bsdf_sample(c.brdf, c.wo, sample_1d(c.id, base + DIM_BSDF_LOBE), u);
         }
     }
+    return s;
+}
+
+/// f at a direction sample: the sample's own for a delta lobe, bsdf_eval otherwise.
+fn direction_f(c: ShadingCtx, ds: BsdfSample) -> vec3<f32> {
+    if (ds.delta) { return ds.f; }
+    return bsdf_eval(c.brdf, c.wo, ds.wi);
 }
 
 /// Spawns a ray leaving the surface along world direction w (offset to the side w points to).
@@ -109,6 +132,8 @@ struct LightEstimate {
 fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     var out = LightEstimate(vec3<f32>(0.0), LightMeasure(MEASURE_NONE, 0.0));
     if (params.num_lights == 0u) { return out; }
+    // A delta-only BSDF is zero in every direction a light sample can take: no shadow ray.
+    if (bsdf_is_delta(c.brdf)) { return out; }
     if (cfg_light_select() == LIGHT_SELECT_RIS) { return ris_light_technique(c, j); }
     let base = dim_base(c.bounce, j);
     let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT), c.x.p, c.x.ns);
@@ -117,10 +142,10 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     let ls = light_sample_li(li, c.x.p, u);
     out.m = ls.m;
     if (!(ls.pdf > 0.0) || !(pmf > 0.0)) { return out; }
-    // Reflection only: the light must be above both the shading and the geometric hemisphere.
+    // The light must be on a side the BSDF allows, by both the shading and the geometric normal.
     let cos_s = dot(ls.wi, c.x.ns);
-    if (cos_s <= 0.0 || dot(ls.wi, c.x.ng) <= 0.0) { return out; }
     let wi = to_local(c.frame, ls.wi);
+    if (cos_s == 0.0 || (cos_s < 0.0 && !bsdf_transmits(c.brdf)) || wrong_side(c, ls.wi, wi)) { return out; }
     let f = bsdf_eval(c.brdf, c.wo, wi);
     if (all(f * ls.radiance == vec3<f32>(0.0)) || !unoccluded(c.x, ls)) { return out; }
     let p_light = pmf * ls.pdf;
@@ -128,7 +153,7 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     if (mis_on() && ls.m.measure != MEASURE_DISCRETE) {
         w = mis_weight(f32(params.light_samples), p_light, f32(params.bsdf_samples), direction_pdf(c, wi));
     }
-    out.radiance = w * ls.radiance * f * cos_s / p_light;
+    out.radiance = w * ls.radiance * f * abs(cos_s) / p_light;
     return out;
 }
 
@@ -147,8 +172,11 @@ fn ris_candidate(c: ShadingCtx, u: vec4<f32>) -> RisCandidate {
     r.ls = light_sample_li(li, c.x.p, u.yzw);
     r.ls.pdf *= light_pmf(li, c.x.p, c.x.ns);
     let cos_s = dot(r.ls.wi, c.x.ns);
-    if (!(r.ls.pdf > 0.0) || cos_s <= 0.0 || dot(r.ls.wi, c.x.ng) <= 0.0) { return r; }
-    r.f_cos = bsdf_eval(c.brdf, c.wo, to_local(c.frame, r.ls.wi)) * cos_s;
+    let wi = to_local(c.frame, r.ls.wi);
+    if (!(r.ls.pdf > 0.0) || cos_s == 0.0 || (cos_s < 0.0 && !bsdf_transmits(c.brdf)) || wrong_side(c, r.ls.wi, wi)) {
+        return r;
+    }
+    r.f_cos = bsdf_eval(c.brdf, c.wo, wi) * abs(cos_s);
     r.p_hat = luminance(r.f_cos * r.ls.radiance);
     return r;
 }
@@ -257,6 +285,13 @@ fn strategy_plan(c: ShadingCtx) -> Plan {
     if (s != STRATEGY_LIGHT) { p.dir_runs = params.bsdf_samples; }
     p.light_div = f32(p.light_runs);
     p.dir_scale = 1.0 / f32(max(p.dir_runs, 1u));
+    // Delta lobes: light samples cannot contribute, so MIS gives the whole weight to the direction samples (their
+    // emission counts with weight 1). Light-only sampling stays without them (the warning says what it misses).
+    if (bsdf_is_delta(c.brdf)) {
+        p.light_runs = 0u;
+        p.light_div = 1.0;
+        return p;
+    }
     if (s == STRATEGY_MIS && cfg_mis_kind() == MIS_ONE) {
         // One-sample MIS: pick the light technique with probability c_l = n_l / (n_l + n_d); the
         // estimate is w_i·f/(c_i·p_i) for the chosen technique i (Veach §9.2.4).
@@ -280,6 +315,7 @@ struct Shaded {
     next_dir: vec3<f32>,
     next_weight: vec3<f32>,   // f·cos/pdf of next_dir
     next_pdf: f32,
+    next_delta: bool,         // next_dir is a delta lobe's: its emission counts with MIS weight 1
     next_scale: f32,          // 0 where the strategy counts no direction sample here (light sampling, or one-sample
                               // MIS chose the light): then the direction only continues the path
 }
@@ -303,28 +339,31 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     if (SPEC_ONE_DIRECTION != 1u || all_here) {
         for (var j = select(1u, 0u, all_here); j < min(plan.dir_runs, 64u); j += 1u) {
             let ds = direction_sample(c, j);
-            if (!(ds.w > 0.0)) { continue; }
-            let w = to_world(c.frame, ds.xyz);
-            if (dot(w, c.x.ng) <= 0.0) { continue; }
+            if (!(ds.pdf > 0.0)) { continue; }
+            let w = to_world(c.frame, ds.wi);
+            if (wrong_side(c, w, ds.wi)) { continue; }
             let o = spawn_origin(c.x, w);
             rays_traced += 1u;
             let found = found_emission(o, w, trace_closest(o, w, F32_MAX));
             if (all(found.le == vec3<f32>(0.0))) { continue; }
-            let f = bsdf_eval(c.brdf, c.wo, ds.xyz);
-            out.radiance += direction_mis_weight(ds.w, found, c.x.p, c.x.ns, w, out.light) * found.le * f * ds.z / ds.w * plan.dir_scale;
+            let f = direction_f(c, ds);
+            var mis = 1.0;
+            if (!ds.delta) { mis = direction_mis_weight(ds.pdf, found, c.x.p, c.x.ns, w, out.light); }
+            out.radiance += mis * found.le * f * abs(ds.wi.z) / ds.pdf * plan.dir_scale;
         }
     }
     out.next_valid = false;
     if (all_here || (!want_next && plan.dir_runs == 0u)) { return out; }
     let ds = direction_sample(c, 0u);
-    if (!(ds.w > 0.0)) { return out; }
-    let w = to_world(c.frame, ds.xyz);
-    if (dot(w, c.x.ng) <= 0.0) { return out; }
+    if (!(ds.pdf > 0.0)) { return out; }
+    let w = to_world(c.frame, ds.wi);
+    if (wrong_side(c, w, ds.wi)) { return out; }
     out.next_valid = true;
     out.next_origin = spawn_origin(c.x, w);
     out.next_dir = w;
-    out.next_weight = bsdf_eval(c.brdf, c.wo, ds.xyz) * ds.z / ds.w;
-    out.next_pdf = ds.w;
+    out.next_weight = direction_f(c, ds) * abs(ds.wi.z) / ds.pdf;
+    out.next_pdf = ds.pdf;
+    out.next_delta = ds.delta;
     out.next_scale = select(0.0, plan.dir_scale, plan.dir_runs > 0u);
     return out;
 }

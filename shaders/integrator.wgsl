@@ -27,6 +27,7 @@ struct PathRay {
     from_p: vec3<f32>,       // the shading point it leaves (for the light technique's pdf of what it finds)
     from_n: vec3<f32>,       // its shading normal (the light tree's selection depends on it)
     dir_pdf: f32,            // pdf of the direction technique that chose d
+    dir_delta: bool,         // d is a delta lobe's sample: no light technique competes, MIS weight 1
     emission_scale: f32,     // factor on the emission it finds (0: not a counted direction sample)
     light: LightMeasure,     // how the first light sample at from_p was drawn
     beta: vec3<f32>,         // throughput, including f·cos/pdf of d
@@ -42,6 +43,7 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
     r.from_p = params.cam_origin;
     r.from_n = vec3<f32>(0.0);
     r.dir_pdf = 0.0;
+    r.dir_delta = false;
     r.emission_scale = 1.0;
     r.light = LightMeasure(MEASURE_NONE, 0.0);
     r.beta = vec3<f32>(1.0);
@@ -59,7 +61,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     let found = found_emission(ray.o, ray.d, hit);
     // The camera ray is no direction technique's sample: its emission counts in full.
     var w = ray.emission_scale;
-    if (ray.bounce > 0u && w > 0.0 && any(found.le != vec3<f32>(0.0))) {
+    if (ray.bounce > 0u && w > 0.0 && !ray.dir_delta && any(found.le != vec3<f32>(0.0))) {
         w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.d, ray.light);
     }
     (*r).l += ray.beta * (w * found.le);
@@ -85,6 +87,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     (*r).from_p = x.p;
     (*r).from_n = x.ns;
     (*r).dir_pdf = s.next_pdf;
+    (*r).dir_delta = s.next_delta;
     (*r).emission_scale = s.next_scale;
     (*r).light = s.light;
     (*r).beta = beta;

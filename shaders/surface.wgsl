@@ -115,7 +115,10 @@ fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) ->
 fn material_bsdf(m: Material, uv: vec2<f32>) -> BsdfParams {
     var p = BsdfParams(m.base_color, m.metallic, m.alpha, m.specular, m.bsdf_kind, m.eta, m.alpha_v, m.k);
     if (HAS_TEXTURES && m.base_tex != INVALID) {
-        p.base_color *= texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
+        let t = texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
+        p.base_color *= t;
+        // Diffuse transmission with a textured transmittance: metallic = 1 says the base texture tints it too.
+        if (HAS_DIFFUSE_TRANSMISSION && m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION && m.metallic > 0.0) { p.k *= t; }
     }
     if (HAS_TEXTURES && m.mr_tex != INVALID) {
         let mr = texture_lookup(m.mr_tex, m.mr_xform0, m.mr_xform1, uv);

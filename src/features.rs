@@ -47,6 +47,10 @@ pub struct Features {
     pub conductor: bool,
     /// Any `MaterialKind::CoatedDiffuse` (shaders/bsdf_coated_diffuse.wgsl).
     pub coated_diffuse: bool,
+    /// Any `MaterialKind::Dielectric` (shaders/bsdf_dielectric.wgsl).
+    pub dielectric: bool,
+    /// Any `MaterialKind::DiffuseTransmission` (shaders/bsdf_diffuse_transmission.wgsl).
+    pub diffuse_transmission: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
     /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
@@ -75,6 +79,8 @@ impl Features {
             diffuse: true,
             conductor: true,
             coated_diffuse: true,
+            dielectric: true,
+            diffuse_transmission: true,
             many_lights: true,
             flat: None,
             baked: 0,
@@ -105,6 +111,8 @@ impl Features {
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
             coated_diffuse: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_COATED_DIFFUSE),
+            dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
+            diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
             many_lights: data.lights.len() > 1,
             flat: crate::baked::flat_counts(data),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {
@@ -133,6 +141,8 @@ impl Features {
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("HAS_CONDUCTOR", b(self.conductor)),
             ("HAS_COATED_DIFFUSE", b(self.coated_diffuse)),
+            ("HAS_DIELECTRIC", b(self.dielectric)),
+            ("HAS_DIFFUSE_TRANSMISSION", b(self.diffuse_transmission)),
             ("MANY_LIGHTS", b(self.many_lights)),
             ("FLAT_SCENE", b(self.flat.is_some())),
         ]
@@ -158,6 +168,8 @@ impl Features {
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);
         on("coated diffuse (GGX dielectric coat over Lambert)", self.coated_diffuse);
+        on("dielectric (Fresnel reflection and refraction)", self.dielectric);
+        on("diffuse transmission", self.diffuse_transmission);
         on("light selection", self.many_lights);
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));

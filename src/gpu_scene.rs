@@ -189,8 +189,17 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
     let kind = material_kind(m);
     GpuMaterial {
-        base_color: m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0)),
-        metallic: finite(m.metallic, 0.0).clamp(0.0, 1.0),
+        // Kinds that carry their own colour (tint, reflectance) put it in base_color themselves.
+        base_color: if matches!(kind.bsdf_kind, MATERIAL_DIELECTRIC | MATERIAL_DIFFUSE_TRANSMISSION) {
+            kind.base_color
+        } else {
+            m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0))
+        },
+        metallic: if kind.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION {
+            kind.metallic
+        } else {
+            finite(m.metallic, 0.0).clamp(0.0, 1.0)
+        },
         emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
         alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
         specular: finite(m.specular, 1.0).clamp(0.0, 1.0),
@@ -229,6 +238,27 @@ fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
             eta: [finite(*eta, 1.5).clamp(1.0001, 10.0), 1.0, 1.0],
             alpha: alpha(*alpha_u),
             alpha_v: alpha(*alpha_v),
+            ..Default::default()
+        },
+        MaterialKind::Dielectric { eta, alpha_u, alpha_v, tint, thin } => GpuMaterial {
+            bsdf_kind: MATERIAL_DIELECTRIC,
+            // η = 1 has no interface to refract at; keep it off 1 so the Walter half vector stays defined.
+            // eta[1]: the thin-slab flag.
+            eta: {
+                let e = finite(*eta, 1.5).clamp(1e-3, 1e3);
+                [if (e - 1.0).abs() < 1e-4 { 1.0001 } else { e }, if *thin { 1.0 } else { 0.0 }, 0.0]
+            },
+            alpha: alpha(*alpha_u),
+            alpha_v: alpha(*alpha_v),
+            base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
+            ..Default::default()
+        },
+        MaterialKind::DiffuseTransmission { reflectance, transmittance, transmittance_textured } => GpuMaterial {
+            bsdf_kind: MATERIAL_DIFFUSE_TRANSMISSION,
+            // metallic (unused by this kind): 1 = the base texture multiplies the transmittance too.
+            metallic: if *transmittance_textured { 1.0 } else { 0.0 },
+            base_color: reflectance.to_array().map(|c| finite(c, 0.0).max(0.0)),
+            k: transmittance.to_array().map(|c| finite(c, 0.0).max(0.0)),
             ..Default::default()
         },
     }

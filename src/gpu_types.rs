@@ -103,6 +103,12 @@ pub struct GpuMaterial {
 pub const MATERIAL_METALLIC_ROUGHNESS: u32 = 0;
 pub const MATERIAL_CONDUCTOR: u32 = 1;
 pub const MATERIAL_COATED_DIFFUSE: u32 = 3;
+/// `MaterialKind::Dielectric`: eta[0] = η, eta[1] = thin (1/0), alpha/alpha_v, base_color = tint
+/// (shaders/bsdf_dielectric.wgsl).
+pub const MATERIAL_DIELECTRIC: u32 = 2;
+/// `MaterialKind::DiffuseTransmission`: base_color = reflectance (× base_tex), k = transmittance (× base_tex
+/// where metallic = 1).
+pub const MATERIAL_DIFFUSE_TRANSMISSION: u32 = 4;
 
 /// One entry of the light table (WGSL `Light`).
 #[repr(C)]

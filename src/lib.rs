@@ -26,6 +26,7 @@ pub mod output_file;
 pub mod pipeline_cache;
 pub mod probe;
 pub mod progressive;
+pub mod reachability;
 pub mod reference;
 pub mod render;
 pub mod render_error;

@@ -143,17 +143,6 @@ fn load_scene(spec: &SceneSpec) -> Result<scene::Scene, Failure> {
     spec.load().map_err(bad)
 }
 
-/// Lights a strategy can never reach (delta lights under direction-only strategies): say so once.
-fn unreachable_light_warning(data: &SceneData, s: &Settings) -> Option<String> {
-    let direction_only = matches!(s.strategy, Strategy::Uniform | Strategy::Cosine | Strategy::Bsdf);
-    (direction_only && data.delta_lights > 0).then(|| {
-        format!(
-            "--strategy {} cannot reach the scene's {} point/spot/directional light(s) (they are delta distributions that only light sampling finds); their light is missing from this image",
-            s.strategy, data.delta_lights
-        )
-    })
-}
-
 fn stress(filter: Option<&str>) -> Result<u8, Failure> {
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
@@ -244,7 +233,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
             n => format!(" ({:.0} B/triangle)", data.bvh_bytes() as f64 / n as f64),
         },
     );
-    if let Some(w) = unreachable_light_warning(&data, &settings) {
+    if let Some(w) = mislab::reachability::unreachable_light_warning(&data, &settings) {
         eprintln!("warning: {w}");
     }
     let scene_hash = mislab::state::scene_hash(&data, &scene.camera);

@@ -30,6 +30,8 @@ pub const RENDER_FILES: &[&str] = &[
     "scene_data.wgsl",
     "bsdf_conductor.wgsl",
     "bsdf_coated_diffuse.wgsl",
+    "bsdf_dielectric.wgsl",
+    "bsdf_diffuse_transmission.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
     "lights.wgsl",

@@ -13,6 +13,8 @@ pub const FILES: &[(&str, &str)] = &[
     ("warps.wgsl", include_str!("../shaders/warps.wgsl")),
     ("bsdf_conductor.wgsl", include_str!("../shaders/bsdf_conductor.wgsl")),
     ("bsdf_coated_diffuse.wgsl", include_str!("../shaders/bsdf_coated_diffuse.wgsl")),
+    ("bsdf_dielectric.wgsl", include_str!("../shaders/bsdf_dielectric.wgsl")),
+    ("bsdf_diffuse_transmission.wgsl", include_str!("../shaders/bsdf_diffuse_transmission.wgsl")),
     ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),

@@ -23,7 +23,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 67;
+const FAMILY: usize = 73;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -87,9 +87,12 @@ fn probe_u(i: u32) -> vec4<f32> {
     return h;
 }
 
-// a = (α, specular, kind, α_v), b = (base colour, metallic); η, k do not change where samples go.
+// a = (α, specular, kind, α_v), b = (base colour, metallic); a conductor's η, k do not change where samples go.
+// A dielectric's η does: p.w (0: 1.5). Diffuse transmission's transmittance k is b.w (its metallic is unused).
 fn probe_bsdf() -> BsdfParams {
-    return BsdfParams(probe_job.b.xyz, probe_job.b.w, probe_job.a.x, probe_job.a.y, u32(probe_job.a.z), vec3<f32>(1.5), probe_job.a.w, vec3<f32>(3.0));
+    let eta = select(vec3<f32>(1.5), vec3<f32>(probe_job.p.w, 0.0, 0.0), probe_job.p.w > 0.0);
+    let k = select(vec3<f32>(3.0), vec3<f32>(probe_job.b.w), u32(probe_job.a.z) == MATERIAL_DIFFUSE_TRANSMISSION);
+    return BsdfParams(probe_job.b.xyz, probe_job.b.w, probe_job.a.x, probe_job.a.y, u32(probe_job.a.z), eta, probe_job.a.w, k);
 }
 
 /// The light's geometric normal at y (either orientation), as surface_at computes it.
@@ -149,6 +152,7 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             let s = bsdf_sample(probe_bsdf(), p, u.z, u.xy);
             o0 = vec4<f32>(s.wi, s.pdf);
             if (s.pdf > 0.0) { o1.x = bsdf_pdf(probe_bsdf(), p, s.wi); }
+            o1.z = s.f.x;    // f of the sample (red), for the f / eval consistency test
         }
         case R_ENV: {
             let s = env_sample(u.xyz);
@@ -191,7 +195,12 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         case R_LIGHT: {
             if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, light_measure(probe_job.light, probe_job.p.xyz), probe_job.p.xyz, w.xyz, y, probe_light_normal(probe_job.light, y)); }
         }
-        case R_BSDF: { pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz); }
+        case R_BSDF: {
+            pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz);
+            // f(wo, w) and f(w, wo) (red), for the reciprocity test.
+            probe_out[i] = vec4<f32>(pdf, bsdf_eval(probe_bsdf(), probe_job.p.xyz, w.xyz).x, bsdf_eval(probe_bsdf(), w.xyz, probe_job.p.xyz).x, 0.0);
+            return;
+        }
         case R_ENV: { pdf = env_pdf(w.xyz); }
         case R_SELECT: { pdf = light_pmf(u32(w.x), probe_job.p.xyz, probe_job.a.xyz); }
         default: {}
@@ -1253,6 +1262,173 @@ fn chi2_conductor() {
     run_all("conductor", &conductor_cases());
 }
 
+/// The rough dielectric (shaders/bsdf_dielectric.wgsl): visible normals, then reflection or refraction by Fresnel,
+/// binned over the whole sphere of wi (both lobes), from outside (η = 1.5) and from inside (η = 1/1.5, where part
+/// of the lobe is totally reflected), anisotropic and isotropic.
+fn dielectric_cases() -> Vec<Case> {
+    let mut v = Vec::new();
+    for (au, av, inc, eta) in [
+        (0.3f32, 0.3f32, 30.0f64, 1.5f32),
+        (0.5, 0.2, 60.0, 1.5),
+        (0.3, 0.3, 45.0, 1.0 / 1.5),
+        (0.25, 0.6, 70.0, 1.0 / 1.5),
+    ] {
+        let t = deg(inc);
+        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let mut c = bsdf_case(
+            "rough dielectric (VNDF + Fresnel choice)",
+            format!("α_u = {au}, α_v = {av}, θo = {inc}°, η = {eta:.3}"),
+            wo,
+            [1.0; 3],
+            0.0,
+            au,
+            0.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [au, 0.0, MATERIAL_DIELECTRIC as f32, av];
+        c.setup.job.p[3] = eta;
+        v.push(c);
+    }
+    v
+}
+
+#[test]
+fn chi2_dielectric() {
+    run_all("dielectric", &dielectric_cases());
+}
+
+/// Diffuse transmission (shaders/bsdf_diffuse_transmission.wgsl): a lobe by its largest channel, cosine on either
+/// side, over the whole sphere; wo above and below the surface.
+fn diffuse_transmission_cases() -> Vec<Case> {
+    let mut v = Vec::new();
+    for (r, t, inc) in [(0.8f32, 0.2f32, 30.0f64), (0.3, 0.6, -60.0)] {
+        let th = deg(inc);
+        let wo = DVec3::new(th.sin().abs() * 0.6, th.sin().abs() * 0.8, th.cos() * inc.signum());
+        let mut c = bsdf_case(
+            "diffuse transmission",
+            format!("R = {r}, T = {t}, wo.z = {:.2}", wo.z),
+            wo,
+            [r, r * 0.5, r * 0.25],
+            t,
+            1.0,
+            0.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [1.0, 0.0, MATERIAL_DIFFUSE_TRANSMISSION as f32, 1.0];
+        v.push(c);
+    }
+    v
+}
+
+#[test]
+fn chi2_diffuse_transmission() {
+    run_all("diffuse-transmission", &diffuse_transmission_cases());
+}
+
+/// Reciprocity and sample/eval consistency of the rough dielectric and diffuse transmission on the device: the f a
+/// sample returns is bsdf_eval at its direction; reflection is symmetric, f(wo, wi) = f(wi, wo); and the
+/// dielectric's transmission obeys f(wi, wo) = η'²·f(wo, wi) (η' = η from above: Veach 1997, eq. 5.14, with the
+/// 1/η'² radiance scaling), diffuse transmission's f(wi, wo) = f(wo, wi).
+#[test]
+fn bsdf_reciprocity() {
+    let h = harness();
+    let count = 1u32 << 12;
+    let mut checked = 0;
+    for (kind, eta) in
+        [(MATERIAL_DIELECTRIC, 1.5f32), (MATERIAL_DIELECTRIC, 1.0 / 1.33), (MATERIAL_DIFFUSE_TRANSMISSION, 0.0)]
+    {
+        let wo = DVec3::new(0.5, 0.3, 0.8).normalize();
+        let mut s = Setup::new(SceneId::Lights, R_BSDF);
+        s.job.p = v4(wo, eta as f64);
+        s.job.a = [0.35, 0.0, kind as f32, 0.2];
+        s.job.b = [0.7, 0.7, 0.7, 0.3];
+        let out = h.sample(&s, count, 0, 1, 11);
+        let inputs: Vec<[[f32; 4]; 2]> = out.iter().map(|[a, _]| [[a[0], a[1], a[2], 1.0], [0.0; 4]]).collect();
+        let job = ProbeJob { count, ..s.job };
+        let flat: Vec<[f32; 4]> = inputs.iter().flatten().copied().collect();
+        let evals = h.dispatch(true, s.scene, &s.frame, &job, &flat, count as usize);
+        for ([a, b], e) in out.iter().zip(&evals) {
+            if !(a[3] > 0.0) {
+                continue;
+            }
+            let (f_sample, f_fwd, f_rev) = (b[2] as f64, e[1] as f64, e[2] as f64);
+            assert!(
+                (f_sample - f_fwd).abs() <= 1e-4 * f_fwd.abs() + 1e-7,
+                "kind {kind}: sample f {f_sample} vs eval {f_fwd}"
+            );
+            let transmitted = a[2] < 0.0;
+            let ratio = if transmitted && kind == MATERIAL_DIELECTRIC { (eta * eta) as f64 } else { 1.0 };
+            assert!(
+                (f_rev - ratio * f_fwd).abs() <= 2e-3 * f_rev.abs().max(ratio * f_fwd.abs()) + 1e-6,
+                "kind {kind}, η {eta}, wi {a:?}: f(wi, wo) {f_rev} vs {ratio}·f(wo, wi) {}",
+                ratio * f_fwd
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 3 * count as usize / 2, "too few valid samples ({checked})");
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric (CPU reference, f64): cosine c of incidence on the side the
+/// relative index η = n_t / n_i refers to; 1 beyond the critical angle.
+fn fresnel_dielectric_ref(c: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - c * c) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let ct = (1.0 - sin2_t).sqrt();
+    let rs = (c - eta * ct) / (c + eta * ct);
+    let rp = (eta * c - ct) / (eta * c + ct);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The smooth dielectric's delta lobes on the device against the CPU Fresnel: the reflection sample's probability
+/// is F(θ), the refraction's 1 − F with Snell's direction, the fraction of reflected samples is F (binomial, 5σ),
+/// and beyond the critical angle (η < 1) every sample reflects with probability 1.
+#[test]
+fn smooth_dielectric_fresnel() {
+    let h = harness();
+    let count = 1u32 << 14;
+    for eta in [1.5f64, 1.0 / 1.5, 1.33] {
+        let critical = if eta < 1.0 { eta.asin().to_degrees() } else { 90.0 };
+        for inc in [0.0f64, 20.0, 40.0, 41.5, 41.9, 42.0, 60.0, 85.0] {
+            let t = deg(inc);
+            let wo = DVec3::new(t.sin(), 0.0, t.cos());
+            let mut s = Setup::new(SceneId::Lights, R_BSDF);
+            s.job.p = v4(wo, eta);
+            s.job.a = [0.0, 0.0, MATERIAL_DIELECTRIC as f32, 0.0];
+            s.job.b = [1.0, 1.0, 1.0, 0.0];
+            let f = fresnel_dielectric_ref(wo.z, eta);
+            let out = h.sample(&s, count, 0, 1, 7 + inc as u32);
+            let mut reflected = 0usize;
+            for [a, _] in &out {
+                let wi = d3(a);
+                let p = a[3] as f64;
+                if wi.z > 0.0 {
+                    reflected += 1;
+                    assert!((wi - DVec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-5, "mirror direction {wi:?}");
+                    assert!((p - f).abs() < 2e-5, "η {eta}, θ {inc}°: reflection probability {p} vs Fresnel {f}");
+                } else {
+                    let sin_t = t.sin() / eta;
+                    assert!(sin_t < 1.0, "η {eta}, θ {inc}° (critical {critical:.2}°): refraction under TIR");
+                    assert!((wi.x + sin_t).abs() < 1e-5 && wi.y.abs() < 1e-6, "Snell: {wi:?} vs sinθt {sin_t}");
+                    assert!(
+                        (p - (1.0 - f)).abs() < 2e-5,
+                        "η {eta}, θ {inc}°: refraction probability {p} vs {}",
+                        1.0 - f
+                    );
+                }
+            }
+            let frac = reflected as f64 / count as f64;
+            let sigma = (f * (1.0 - f) / count as f64).sqrt();
+            assert!((frac - f).abs() <= 5.0 * sigma + 1e-9, "η {eta}, θ {inc}°: reflected {frac} vs F {f}");
+            if inc > critical {
+                assert_eq!(reflected, count as usize, "total internal reflection beyond {critical:.2}°");
+            }
+        }
+    }
+}
+
 /// The coated diffuse BSDF's lobe mixture (shaders/bsdf_coated_diffuse.wgsl: the coat's visible normals with
 /// its Fresnel weight, else cosine; η = 1.5 from probe_bsdf), binned over the sphere of wi: a strong and a weak
 /// base, an anisotropic coat, grazing incidence.
@@ -1474,6 +1650,8 @@ fn family_size() {
         + light_cases().len()
         + bsdf_cases().len()
         + conductor_cases().len()
+        + dielectric_cases().len()
+        + diffuse_transmission_cases().len()
         + coated_cases().len()
         + env_cases().len()
         + 2

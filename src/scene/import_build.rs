@@ -149,7 +149,7 @@ impl Builder {
         self.scene.warnings.append(&mut self.warnings);
         if self.invisible_shapes > 0 {
             self.scene.warnings.push(format!(
-                "{} shapes with see-through materials (dielectric, interface) were left out",
+                "{} shapes with see-through materials (interface, null) were left out",
                 self.invisible_shapes
             ));
         }

@@ -59,6 +59,70 @@ pub enum Mapped {
     Invisible,
 }
 
+/// Refractive indices at ~550 nm of the named glasses of pbrt-v4 (its `glass-*` spectra) and of Mitsuba 3's
+/// `int_ior`/`ext_ior` names (the table in Mitsuba's dielectric documentation).
+const NAMED_IORS: &[(&str, f32)] = &[
+    ("glass-BK7", 1.5168),
+    ("glass-BAF10", 1.670),
+    ("glass-FK51A", 1.4866),
+    ("glass-LASF9", 1.850),
+    ("glass-F5", 1.6034),
+    ("glass-F10", 1.6137),
+    ("glass-F11", 1.621),
+    ("vacuum", 1.0),
+    ("helium", 1.00004),
+    ("hydrogen", 1.00013),
+    ("air", 1.00028),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.3330),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.470),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.5750),
+    ("diamond", 2.419),
+];
+
+/// Relative index (inside / outside) of a dielectric: pbrt's `eta` (a number, an RGB triple — its mean, as
+/// mislab has no dispersion — or a named glass), or Mitsuba's `int_ior` / `ext_ior` (numbers or names).
+fn dielectric_eta(desc: &MaterialDesc, warn: &mut impl FnMut(&str)) -> f32 {
+    let mut value = |name: &str, default: f32| match desc.params.get(name) {
+        Some(MatParam::Float(v)) if *v > 0.0 => *v,
+        Some(MatParam::Rgb(c)) => {
+            if c.max_element() - c.min_element() > 1e-4 {
+                warn("a dielectric of one η (the mean of its RGB η; no dispersion)");
+            }
+            (c.x + c.y + c.z) / 3.0
+        }
+        Some(MatParam::Spectrum(s) | MatParam::Str(s)) => {
+            match NAMED_IORS.iter().find(|(n, _)| n.eq_ignore_ascii_case(s)) {
+                Some((_, v)) => *v,
+                None => {
+                    warn("a dielectric of η 1.5 (its named index is unknown)");
+                    1.5
+                }
+            }
+        }
+        _ => default,
+    };
+    if desc.params.contains_key("int_ior") || desc.params.contains_key("ext_ior") {
+        // Mitsuba's defaults: BK7 inside, air outside.
+        return value("int_ior", 1.5046) / value("ext_ior", 1.000277);
+    }
+    value("eta", 1.5)
+}
+
 /// Maps `desc` onto a mislab material, loading its textures into `scene` (through `cache`). Approximations add
 /// one warning each to `warnings`.
 pub fn map(
@@ -87,7 +151,7 @@ pub fn map(
                     ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
                 },
                 // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
-                // normal-incidence reflectance, NAMED_METALS): the complex-Fresnel conductor of that F(0).
+                // normal-incidence reflectance, named_spectra): the complex-Fresnel conductor of that F(0).
                 (_, None) => {
                     let f0 = if desc.params.contains_key("reflectance") { c } else { conductor_f0(desc) * c };
                     if desc.params.get("reflectance").is_none() {
@@ -106,13 +170,56 @@ pub fn map(
             }
         }
         "coateddiffuse" | "plastic" | "roughplastic" => return coated_diffuse(desc, scene, cache, warnings),
-        "diffusetransmission" => {
-            let (c, t) = color(desc, &["reflectance"], Vec3::splat(0.25), scene, cache)?;
-            warn("Lambert reflection only (its transmission is dropped)");
-            with_texture(Material::lambert(&desc.name, c), t)
+        "diffusetransmission" | "difftrans" => {
+            // pbrt-v4: reflectance 0.25, transmittance 0.25, both × scale. Mitsuba 3's difftrans has
+            // transmittance only (its reflection is 0).
+            let mitsuba = desc.kind == "difftrans";
+            let r_default = if mitsuba { Vec3::ZERO } else { Vec3::splat(0.25) };
+            let (r, rt) = color(desc, &["reflectance"], r_default, scene, cache)?;
+            let (tr, tt) =
+                color(desc, &["transmittance"], Vec3::splat(if mitsuba { 0.5 } else { 0.25 }), scene, cache)?;
+            // One texture slot (base_tex): a textured transmittance shares the reflectance's texture, as the living
+            // room's leaves do; a different texture, or a textured transmittance alone, is approximated.
+            let transmittance_textured = tt.is_some();
+            if rt.is_some() && tt.is_some() && rt != tt {
+                warn("diffuse transmission whose transmittance uses the reflectance's texture");
+            }
+            // With only the transmittance textured, the texture tints the (untextured) reflectance too.
+            if rt.is_none() && tt.is_some() && r != Vec3::ZERO {
+                warn("diffuse transmission whose reflectance takes the transmittance's texture too");
+            }
+            let texture = rt.or(tt);
+            let kind = MaterialKind::DiffuseTransmission { reflectance: r, transmittance: tr, transmittance_textured };
+            with_texture(Material { kind, ..Material::lambert(&desc.name, r) }, texture)
         }
-        "dielectric" | "thindielectric" | "roughdielectric" | "interface" | "null" => {
-            warn("invisible: its shapes are left out (no refraction yet; right for thin panes, not for solid glass)");
+        "dielectric" | "roughdielectric" | "thindielectric" => {
+            let thin = desc.kind == "thindielectric";
+            let eta = dielectric_eta(desc, &mut warn);
+            // Smooth unless the file gives a roughness (pbrt's default roughness is 0; Mitsuba's roughdielectric
+            // defaults to α = 0.1).
+            let mut alpha = alpha_of(desc);
+            let rough_default = desc.kind == "roughdielectric" && !desc.params.contains_key("alpha");
+            if rough_default && alpha_uv(desc).is_none() {
+                alpha = 0.1;
+            }
+            let (au, av) = alpha_uv(desc).unwrap_or((alpha, alpha));
+            if thin && au.max(av) >= super::DELTA_ALPHA {
+                warn("a smooth thin dielectric (its roughness is dropped)");
+            }
+            let (tr, _) = color(desc, &["specular_transmittance"], Vec3::ONE, scene, cache)?;
+            let (re, _) = color(desc, &["specular_reflectance"], Vec3::ONE, scene, cache)?;
+            if tr != re {
+                warn("a dielectric with one tint (specular_transmittance) on both lobes");
+            }
+            if desc.params.values().any(|p| matches!(p, MatParam::Texture(_))) {
+                warn("an untextured dielectric");
+            }
+            let (au, av) = if thin { (0.0, 0.0) } else { (au, av) };
+            let kind = MaterialKind::Dielectric { eta, alpha_u: au, alpha_v: av, tint: tr, thin };
+            Material { kind, base_color: tr, specular: 0.0, ..Default::default() }
+        }
+        "interface" | "null" => {
+            warn("invisible: its shapes are left out (an interface between media, which mislab does not have)");
             return Ok(Mapped::Invisible);
         }
         _ => {
@@ -402,5 +509,63 @@ mod tests {
         let d = desc("conductor", vec![("eta", MatParam::Spectrum("metal-Xx-eta".into()))]);
         let Mapped::Material(_) = map(&d, &mut s, &mut c, &mut w).unwrap() else { panic!() };
         assert_eq!(w.len(), 1, "{w:?}");
+    }
+
+    #[test]
+    fn dielectric_and_diffuse_transmission() {
+        let mut s = Scene::default();
+        let mut c = TextureCache::default();
+        let mut w = vec![];
+        let kind = |d: &MaterialDesc, s: &mut Scene, c: &mut TextureCache, w: &mut Vec<String>| match map(d, s, c, w)
+            .unwrap()
+        {
+            Mapped::Material(m) => m.kind,
+            Mapped::Invisible => panic!("{} left out", d.kind),
+        };
+        // pbrt: eta and a remapped roughness (√0.04 = 0.2); remaproughness false keeps it.
+        let d = desc("dielectric", vec![("eta", MatParam::Float(1.33)), ("roughness", MatParam::Float(0.04))]);
+        assert_eq!(
+            kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { eta: 1.33, alpha_u: 0.2, alpha_v: 0.2, tint: Vec3::ONE, thin: false }
+        );
+        let d = desc(
+            "dielectric",
+            vec![
+                ("uroughness", MatParam::Float(0.1)),
+                ("vroughness", MatParam::Float(0.3)),
+                ("remaproughness", MatParam::Bool(false)),
+            ],
+        );
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { eta, alpha_u, alpha_v, .. } if eta == 1.5 && alpha_u == 0.1 && alpha_v == 0.3));
+        assert!(w.is_empty(), "{w:?}");
+        // A named glass: its index at ~550 nm.
+        let d = desc("dielectric", vec![("eta", MatParam::Spectrum("glass-BK7".into()))]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { eta, .. } if eta == 1.5168));
+        // Mitsuba: int_ior / ext_ior by name or number; roughdielectric defaults to α = 0.1; thin is smooth.
+        let d = desc("dielectric", vec![("int_ior", MatParam::Str("water".into())), ("ext_ior", MatParam::Float(1.0))]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { eta, .. } if eta == 1.333));
+        let d = desc("roughdielectric", vec![]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { alpha_u, thin: false, .. } if alpha_u == 0.1));
+        let d = desc("thindielectric", vec![]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { thin: true, alpha_u, .. } if alpha_u == 0.0));
+        assert!(w.is_empty(), "{w:?}");
+        // pbrt's diffusetransmission: reflectance and transmittance × scale.
+        let d = desc(
+            "diffusetransmission",
+            vec![("transmittance", MatParam::Rgb(Vec3::new(0.2, 0.4, 0.6))), ("scale", MatParam::Float(0.5))],
+        );
+        assert_eq!(
+            kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::DiffuseTransmission {
+                reflectance: Vec3::splat(0.125),
+                transmittance: Vec3::new(0.1, 0.2, 0.3),
+                transmittance_textured: false
+            }
+        );
+        // Interfaces between media stay left out.
+        assert!(matches!(map(&desc("interface", vec![]), &mut s, &mut c, &mut w).unwrap(), Mapped::Invisible));
     }
 }

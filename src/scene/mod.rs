@@ -152,7 +152,7 @@ pub enum MaterialKind {
     MetallicRoughness,
     /// A conductor with the complex Fresnel term of RGB `eta` + i·`k`, and an anisotropic GGX
     /// (Trowbridge–Reitz) microsurface of α `alpha_u` along the shading frame's tangent and `alpha_v` along its
-    /// bitangent (α = 0 is clamped to `ALPHA_MIN`: a near-mirror, not yet an exact delta lobe).
+    /// bitangent (α below `DELTA_ALPHA` is the exact mirror, a delta lobe).
     Conductor {
         /// Real part of the index of refraction, per RGB channel.
         eta: Vec3,
@@ -175,7 +175,39 @@ pub enum MaterialKind {
         /// GGX α along the bitangent.
         alpha_v: f32,
     },
+    /// A dielectric interface (glass, water): Fresnel reflection and refraction with relative index `eta` (inside
+    /// over outside, the side the geometric normal points to being outside), over an anisotropic GGX
+    /// microsurface (Walter et al. 2007); `alpha_u`, `alpha_v` below `DELTA_ALPHA` is the smooth interface, an exact
+    /// delta reflection + refraction. `tint` multiplies both lobes (1 = non-absorbing).
+    Dielectric {
+        /// Relative index of refraction (inside / outside), > 0.
+        eta: f32,
+        /// GGX α along the tangent.
+        alpha_u: f32,
+        /// GGX α along the bitangent.
+        alpha_v: f32,
+        /// Factor on reflection and transmission (linear RGB).
+        tint: Vec3,
+        /// A thin slab (Mitsuba's `thindielectric`): the slab's summed internal reflections, and transmission
+        /// straight through (no bending, no 1/η² scaling); always smooth.
+        thin: bool,
+    },
+    /// Lambert reflection (`reflectance`, scaled by the base colour texture where the material has one) plus
+    /// Lambert transmission to the other side (`transmittance`); pbrt-v4's `diffusetransmission`.
+    DiffuseTransmission {
+        /// Diffuse reflectance (linear RGB).
+        reflectance: Vec3,
+        /// Diffuse transmittance (linear RGB).
+        transmittance: Vec3,
+        /// Whether the transmittance is multiplied by the base colour texture too (pbrt's living-room leaves use
+        /// one texture for both).
+        transmittance_textured: bool,
+    },
 }
+
+/// GGX α below which a conductor or dielectric is an exact mirror / smooth interface (delta lobes), as pbrt-v4's
+/// `EffectivelySmooth`.
+pub const DELTA_ALPHA: f32 = 1e-3;
 
 impl MaterialKind {
     /// The conductor whose normal-incidence Fresnel reflectance is `r` (per channel, in [0, 1)), as pbrt-v4's

@@ -107,6 +107,9 @@ struct MaterialDef {
     k: Option<Splat<3>>,
     alpha_u: Option<f32>,
     alpha_v: Option<f32>,
+    tint: Option<Splat<3>>,
+    transmittance: Option<Splat<3>>,
+    thin: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -444,6 +447,9 @@ fn material(
         ("k", d.k.is_some()),
         ("alpha_u", d.alpha_u.is_some()),
         ("alpha_v", d.alpha_v.is_some()),
+        ("tint", d.tint.is_some()),
+        ("transmittance", d.transmittance.is_some()),
+        ("thin", d.thin.is_some()),
     ];
     let allowed: &[&str] = match d.kind.as_str() {
         "lambert" => &["reflectance", "emission"],
@@ -451,9 +457,12 @@ fn material(
         "metallic-roughness" => &["base_color", "metallic", "roughness", "specular", "emission"],
         "coated-diffuse" => &["reflectance", "eta", "alpha", "alpha_u", "alpha_v", "emission"],
         "emitter" => &["emission"],
+        "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "tint", "thin", "emission"],
+        "diffuse-transmission" => &["reflectance", "transmittance", "emission"],
         other => {
             return Err(e(&format!(
-                "unknown type \"{other}\" (expected lambert, conductor, metallic-roughness, coated-diffuse or emitter)"
+                "unknown type \"{other}\" (expected lambert, conductor, metallic-roughness, coated-diffuse, \
+                 dielectric, diffuse-transmission or emitter)"
             )))
         }
     };
@@ -527,6 +536,32 @@ fn material(
                 kind: MaterialKind::CoatedDiffuse { eta: eta.x, alpha_u, alpha_v },
                 ..Material::coated_diffuse(name, reflectance, eta.x, alpha_u)
             }
+        }
+        "dielectric" => {
+            // Smooth (α = 0, delta lobes) unless α is given, once or per axis.
+            let a = match (d.alpha, d.alpha_u, d.alpha_v) {
+                (a, None, None) => (a.unwrap_or(0.0), a.unwrap_or(0.0)),
+                (None, Some(u), Some(v)) => (u, v),
+                _ => return Err(e("a dielectric takes 'alpha', or both 'alpha_u' and 'alpha_v'")),
+            };
+            let (alpha_u, alpha_v) = (unit("alpha_u", Some(a.0), 0.0)?, unit("alpha_v", Some(a.1), 0.0)?);
+            let eta = color("eta", d.eta, 1.5)?;
+            if eta.min_element() <= 0.0 || eta.max_element() != eta.min_element() {
+                return Err(e("a dielectric's eta must be one positive number (relative index inside/outside)"));
+            }
+            let thin = d.thin.unwrap_or(false);
+            if thin && alpha_u.max(alpha_v) > 0.0 {
+                return Err(e("a thin dielectric is smooth: it takes no 'alpha'"));
+            }
+            let tint = color("tint", d.tint, 1.0)?;
+            let kind = MaterialKind::Dielectric { eta: eta.x, alpha_u, alpha_v, tint, thin };
+            Material { name: name.into(), kind, base_color: tint, specular: 0.0, ..Default::default() }
+        }
+        "diffuse-transmission" => {
+            let reflectance = color("reflectance", d.reflectance, 0.25)?;
+            let transmittance = color("transmittance", d.transmittance, 0.25)?;
+            let kind = MaterialKind::DiffuseTransmission { reflectance, transmittance, transmittance_textured: false };
+            Material { kind, ..Material::lambert(name, reflectance) }
         }
         "metallic-roughness" => Material {
             name: name.into(),

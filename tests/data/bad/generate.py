@@ -755,7 +755,7 @@ tm("colour-four-numbers", LIT.replace("reflectance = 0.8", "reflectance = [0.5, 
 tm("colour-string", LIT.replace("reflectance = 0.8", 'reflectance = "red"'), "error", "invalid type: string \"red\"")
 # Materials.
 tm("material-unknown-type", LIT.replace('type = "lambert"', 'type = "glass"'), "error",
-   "line 5: material 'white': unknown type \"glass\" (expected lambert, conductor, metallic-roughness, coated-diffuse or emitter)")
+   "line 5: material 'white': unknown type \"glass\" (expected lambert, conductor, metallic-roughness, coated-diffuse, dielectric, diffuse-transmission or emitter)")
 tm("material-key-not-for-type", LIT.replace("reflectance = 0.8", "reflectance = 0.8\nalpha = 0.1"), "error",
    "material 'white': type \"lambert\" does not take 'alpha'")
 tm("material-conductor-no-alpha", LIT.replace('type = "lambert"', 'type = "conductor"'), "error", "type \"conductor\" needs 'alpha'")
