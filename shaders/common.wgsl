@@ -91,7 +91,7 @@ struct TriShading {
     n1: vec3<f32>,
     light: u32,
     n2: vec3<f32>,
-    _pad0: u32,
+    alpha_texture: u32,    // cut-out mask: 0 none, k + 1 texture k's alpha channel (alpha.wgsl)
     uv0: vec2<f32>,
     uv1: vec2<f32>,
     uv2: vec2<f32>,
@@ -140,7 +140,7 @@ struct Light {
     area: f32,
     pmf_uniform: f32,
     tree_trail: u32,       // the light's root-to-leaf path in light_tree (bit k: second child at depth k)
-    _pad0: u32,
+    two_sided: u32,        // 1: an area light emitting from both faces (triangles, quads)
     _pad1: u32,
     _pad2: u32,
 }
@@ -272,6 +272,8 @@ override HAS_TEXTURES: bool = true;
 override HAS_SPECULAR: bool = true;
 /// Any MaterialKind::Conductor (bsdf_conductor.wgsl).
 override HAS_CONDUCTOR: bool = true;
+/// Any triangle with a cut-out mask (alpha.wgsl); false = no alpha test in traversal.
+override HAS_ALPHA: bool = true;
 /// Whether any material has a diffuse lobe.
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.

@@ -322,7 +322,8 @@ pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
     let total = args.spp.unwrap_or(0);
     let range = args.part.map_or((0, total), |(k, n)| crate::state::session::part_range(k, n, total));
     let budget = if args.part.is_some() { Budget::Samples(range.1 - range.0) } else { budget };
-    if range.0 == range.1 {
+    // (Without --part a --time budget has no sample count: the range is unused.)
+    if args.part.is_some() && range.0 == range.1 {
         return Err(format!("--part of --spp {total} holds no samples (use at most {total} parts)"));
     }
     let (film, stats) = render_reference_from(&ctx, data, &scene, &settings, budget, 0, range.0, &stop)?;

@@ -29,6 +29,7 @@ pub const RENDER_FILES: &[&str] = &[
     "bsdf_conductor.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
+    "alpha.wgsl",
     "lights.wgsl",
     "light_tree.wgsl",
     "mis.wgsl",
