@@ -24,8 +24,9 @@ pub struct CompareArgs {
     /// Also write a side-by-side PNG (image left, reference right; sRGB, clamped, same exposure).
     #[arg(long, value_name = "PNG")]
     pub side_by_side: Option<PathBuf>,
-    /// Width of each panel of --side-by-side in pixels (box-filtered down from the images).
-    #[arg(long, default_value_t = 320)]
+    /// Width of each panel of --side-by-side in pixels (box-filtered down from the images); 0 = about 20,000
+    /// pixels per panel (a noisy pair stays near 100 KB).
+    #[arg(long, default_value_t = 0)]
     pub panel_width: u32,
     /// Exposure (stops) of --side-by-side.
     #[arg(long, default_value_t = 0.0)]
@@ -205,6 +206,10 @@ pub fn write_side_by_side(
     panel_width: u32,
     exposure: f32,
 ) -> Result<(), String> {
+    let panel_width = match panel_width {
+        0 => ((20_000.0 * image.width as f64 / image.height as f64).sqrt() as u32).max(1),
+        w => w,
+    };
     let (a, b) = (downscale(image, panel_width), downscale(reference, panel_width));
     let gap = 4;
     let (w, h) = (a.width + gap + b.width, a.height.max(b.height));
@@ -221,8 +226,13 @@ pub fn write_side_by_side(
             }
         }
     }
-    crate::output_file::check(path, true)?
-        .write(|tmp| out.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| format!("{}: {e}", path.display())))
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    crate::output_file::check(path, true)?.write(|tmp| {
+        let file = std::fs::File::create(tmp).map_err(|e| format!("{}: {e}", path.display()))?;
+        let encoder =
+            PngEncoder::new_with_quality(std::io::BufWriter::new(file), CompressionType::Best, FilterType::Adaptive);
+        out.write_with_encoder(encoder).map_err(|e| format!("{}: {e}", path.display()))
+    })
 }
 
 /// Runs `mislab compare`: prints the table (or JSON); bad or mismatched input is an error (exit 2).

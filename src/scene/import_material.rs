@@ -95,6 +95,10 @@ pub fn map(
                 (Some(MatParam::Rgb(eta)), Some(MatParam::Rgb(k)), None)
                     if desc.params.get("reflectance").is_none() =>
                 {
+                    // Mitsuba's specular_reflectance scales the Fresnel term; the conductor kind has no tint yet.
+                    if c != Vec3::ONE {
+                        warn("a complex-Fresnel conductor without its specular_reflectance tint (rendered as 1)");
+                    }
                     Material {
                         kind: MaterialKind::Conductor { eta: *eta, k: *k, alpha_u: au, alpha_v: av },
                         ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
