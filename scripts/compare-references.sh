@@ -6,7 +6,8 @@
 #   scripts/compare-references.sh [OUT_DIR]        (default /tmp/mislab-references)
 # Environment:
 #   MISLAB       the binary (default target/release/mislab; build it first)
-#   DIV          render at 1/DIV of the reference size per axis; blocks shrink to 16/DIV px (default 4)
+#   DIV          render at 1/DIV of the reference size per axis (DIV must divide both, and 16); blocks shrink to
+#                16/DIV px (default 4)
 #   TIME         seconds of rendering per Tungsten comparison (default 150; this 2-core machine, lavapipe)
 #   ONLY         a regular expression: only the scenes whose name matches
 #   MITSUBA_PY   a python with mitsuba 3.9.1 (scratch venv, never a dependency); unset = skip that table
@@ -50,7 +51,8 @@ for ref in "$scenes"/*/pbrt-v4/TungstenRender.exr; do
   dir=$(dirname "$ref")
   name=$(basename "$(dirname "$dir")")
   [[ $name =~ $only ]] || continue
-  case $name in staircase2) w=1024 h=1024 ;; *) w=1280 h=720 ;; esac
+  # The reference's own size, from compare's JSON.
+  read -r w h < <("$mislab" compare "$ref" "$ref" --json | python3 -c 'import json, sys; print(*json.load(sys.stdin)["sizes"][1])')
   w=$((w / div)) h=$((h / div))
   depth=$(depth_of "$dir/scene-v4.pbrt")
   log=$out/$name.log

@@ -67,6 +67,8 @@ pub struct Comparison {
     pub blocks: usize,
     /// Non-finite pixel values in the image and in the reference (they make the metrics non-finite).
     pub nonfinite: [usize; 2],
+    /// Width and height of the image and of the reference.
+    pub sizes: [[u32; 2]; 2],
 }
 
 /// Reads an EXR (or render state) as linear RGB.
@@ -149,6 +151,7 @@ pub fn compare(image: &Image, reference: &Image, block: u32) -> Result<Compariso
         block_reference: block,
         blocks: mi.len(),
         nonfinite: [nonfinite(image), nonfinite(reference)],
+        sizes: [[image.width, image.height], [reference.width, reference.height]],
     })
 }
 
