@@ -278,7 +278,8 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
                         if prim == skip { continue; }
                         h = intersect_prim(r, prim, hit.t);
                     }
-                    if h.w != 0.0 {
+                    // A cut-out point is no hit (HAS_ALPHA is false, and this test gone, in scenes without masks).
+                    if h.w != 0.0 && !(HAS_ALPHA && alpha_cut_out(prim, h.y, h.z)) {
                         hit = Hit(h.x, prim, h.y, h.z);
                         if any_hit {
                             return hit;

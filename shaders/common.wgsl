@@ -91,7 +91,7 @@ struct TriShading {
     n1: vec3<f32>,
     light: u32,
     n2: vec3<f32>,
-    _pad0: u32,
+    alpha_texture: u32,    // cut-out mask: 0 none, k + 1 texture k's alpha channel (alpha.wgsl)
     uv0: vec2<f32>,
     uv1: vec2<f32>,
     uv2: vec2<f32>,
@@ -145,7 +145,7 @@ struct Light {
     area: f32,
     pmf_uniform: f32,
     tree_trail: u32,       // the light's root-to-leaf path in light_tree (bit k: second child at depth k)
-    _pad0: u32,
+    two_sided: u32,        // 1: an area light emitting from both faces (triangles, quads)
     _pad1: u32,
     _pad2: u32,
 }
@@ -283,6 +283,8 @@ override HAS_COATED_DIFFUSE: bool = true;
 override HAS_DIELECTRIC: bool = true;
 /// Any MaterialKind::DiffuseTransmission (bsdf_diffuse_transmission.wgsl).
 override HAS_DIFFUSE_TRANSMISSION: bool = true;
+/// Any triangle with a cut-out mask (alpha.wgsl); false = no alpha test in traversal.
+override HAS_ALPHA: bool = true;
 /// Whether any material has a diffuse lobe.
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.

@@ -14,8 +14,9 @@
 //                                         m = K_measure(l, p); 0 for delta lights;
 //   K_eval(l, y, wi) -> vec3<f32>         the radiance the light emits along wi from the point y a ray found (the
 //                                         environment ignores y); 0 for delta lights, which no ray finds.
-// No pdf here includes the selection probability (`light_pmf`). Emitters are one-sided: from behind a triangle
-// or quad, p gets no light (MEASURE_NONE) and pdf_li is 0. The dispatchers light_measure / light_sample_li /
+// No pdf here includes the selection probability (`light_pmf`). Emitters are one-sided unless `l.two_sided`: from
+// behind a one-sided triangle or quad, p gets no light (MEASURE_NONE) and pdf_li is 0; a two-sided one seen from
+// behind is sampled as its mirror twin (the same points, winding reversed), so the one-sided code applies. The dispatchers light_measure / light_sample_li /
 // light_pdf_li / light_eval (last section) have one `case` per kind; tests/shaders.rs checks that and that nothing
 // else switches on the kind.
 
@@ -139,9 +140,10 @@ fn area_to_solid_angle(p: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>, pdf_area: f32
     return LightSample(wi, dist, emitted, pdf_area * d2 / cos_l, LightMeasure(MEASURE_AREA, 0.0), prim);
 }
 
-/// The emission of an area light at the point y a ray found: its material's, on the front face only.
-fn area_eval(y: Surface) -> vec3<f32> {
-    if (!y.front) { return vec3<f32>(0.0); }
+/// The emission of an area light at the point y a ray found: its material's, on the front face only unless the
+/// light is two-sided.
+fn area_eval(l: Light, y: Surface) -> vec3<f32> {
+    if (!y.front && l.two_sided == 0u) { return vec3<f32>(0.0); }
     return material_emission(scene_material(y.material), y.uv);
 }
 
@@ -160,34 +162,55 @@ fn triangle_measure_of(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, p: vec3<f32>
     return LightMeasure(MEASURE_AREA, 0.0);
 }
 
-fn triangle_measure(l: Light, p: vec3<f32>) -> LightMeasure {
+/// A light triangle's vertices as p sees them: a two-sided light seen from behind has v1 and v2 swapped (`swapped`),
+/// so that p is in front of the same triangle.
+struct TriFromP {
+    v0: vec3<f32>,
+    v1: vec3<f32>,
+    v2: vec3<f32>,
+    swapped: bool,
+}
+
+fn triangle_from(l: Light, p: vec3<f32>) -> TriFromP {
     let tp = scene_tri_positions(l.prim);
-    return triangle_measure_of(tp.v0, tp.v1, tp.v2, p);
+    let behind = dot(p - tp.v0, cross(tp.v1 - tp.v0, tp.v2 - tp.v0)) < 0.0;
+    if (l.two_sided != 0u && behind) { return TriFromP(tp.v0, tp.v2, tp.v1, true); }
+    return TriFromP(tp.v0, tp.v1, tp.v2, false);
+}
+
+/// The uv at barycentrics (b1, b2) of `triangle_from`'s vertices.
+fn triangle_light_uv(prim: u32, b1: f32, b2: f32, swapped: bool) -> vec2<f32> {
+    let sh = scene_tri_shading(prim);
+    return (1.0 - b1 - b2) * sh.uv0 + select(b1, b2, swapped) * sh.uv1 + select(b2, b1, swapped) * sh.uv2;
+}
+
+fn triangle_measure(l: Light, p: vec3<f32>) -> LightMeasure {
+    let t = triangle_from(l, p);
+    return triangle_measure_of(t.v0, t.v1, t.v2, p);
 }
 
 /// Uniform by area (barycentrics by Heitz's low-distortion map). Measure: area → solid angle.
-fn triangle_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let tp = scene_tri_positions(prim);
-    let c = cross(tp.v1 - tp.v0, tp.v2 - tp.v0);
+fn triangle_sample_area(l: Light, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+    let t = triangle_from(l, p);
+    let c = cross(t.v1 - t.v0, t.v2 - t.v0);
     let area2 = length(c);
     if (!(area2 > 0.0)) { return no_light_sample(); }
     let b = square_to_uniform_triangle(u);
-    let y = (1.0 - b.x - b.y) * tp.v0 + b.x * tp.v1 + b.y * tp.v2;
-    let sh = scene_tri_shading(prim);
-    let uv = (1.0 - b.x - b.y) * sh.uv0 + b.x * sh.uv1 + b.y * sh.uv2;
-    let emitted = material_emission(scene_material(sh.material), uv);
-    return area_to_solid_angle(p, y, c / area2, 2.0 / area2, emitted, make_prim(PRIM_TRIANGLE, prim));
+    let y = (1.0 - b.x - b.y) * t.v0 + b.x * t.v1 + b.y * t.v2;
+    let sh = scene_tri_shading(l.prim);
+    let emitted = material_emission(scene_material(sh.material), triangle_light_uv(l.prim, b.x, b.y, t.swapped));
+    return area_to_solid_angle(p, y, c / area2, 2.0 / area2, emitted, make_prim(PRIM_TRIANGLE, l.prim));
 }
 
 /// Uniform in solid angle (spherical triangle, Arvo 1995) where `triangle_measure` allows, else by area.
 fn triangle_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    let tp = scene_tri_positions(l.prim);
+    let tp = triangle_from(l, p);
     let v0 = tp.v0;
     let v1 = tp.v1;
     let v2 = tp.v2;
     let m = triangle_measure_of(v0, v1, v2, p);
     if (m.measure != MEASURE_SOLID_ANGLE) {
-        var s = triangle_sample_area(l.prim, p, u.xy);
+        var s = triangle_sample_area(l, p, u.xy);
         s.m = m;
         return s;
     }
@@ -201,8 +224,7 @@ fn triangle_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let b1 = clamp(dot(cross(y - v0, v2 - v0), n) * inv_nn, 0.0, 1.0);
     let b2 = clamp(dot(cross(v1 - v0, y - v0), n) * inv_nn, 0.0, 1.0);
     let sh = scene_tri_shading(l.prim);
-    let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
-    let emitted = material_emission(scene_material(sh.material), uv);
+    let emitted = material_emission(scene_material(sh.material), triangle_light_uv(l.prim, b1, b2, tp.swapped));
     return LightSample(wi, t, emitted, 1.0 / m.omega, m, make_prim(PRIM_TRIANGLE, l.prim));
 }
 
@@ -217,7 +239,7 @@ fn triangle_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: ve
     return 2.0 * dot(v, v) / c;
 }
 
-fn triangle_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(y); }
+fn triangle_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(l, y); }
 
 // ---- LIGHT_QUAD: an emissive parallelogram ----
 
@@ -257,25 +279,45 @@ fn quad_frame(q: Quad, p: vec3<f32>) -> QuadLightFrame {
     return f;
 }
 
-fn quad_measure(l: Light, p: vec3<f32>) -> LightMeasure { return quad_frame(scene_quad(l.prim), p).m; }
+/// A light quad as p sees it: a two-sided light seen from behind has its edges swapped (`swapped`; the same
+/// points, front facing p), so its uv is (v, u).
+struct QuadFromP {
+    q: Quad,
+    swapped: bool,
+}
+
+fn quad_from(l: Light, p: vec3<f32>) -> QuadFromP {
+    var q = scene_quad(l.prim);
+    if (l.two_sided != 0u && dot(p - q.corner, cross(q.edge_u, q.edge_v)) < 0.0) {
+        let e = q.edge_u;
+        q.edge_u = q.edge_v;
+        q.edge_v = e;
+        return QuadFromP(q, true);
+    }
+    return QuadFromP(q, false);
+}
+
+fn quad_measure(l: Light, p: vec3<f32>) -> LightMeasure { return quad_frame(quad_from(l, p).q, p).m; }
 
 /// Uniform by area. Measure: area → solid angle.
-fn quad_sample_area(prim: u32, p: vec3<f32>, u: vec2<f32>) -> LightSample {
-    let q = scene_quad(prim);
+fn quad_sample_area(l: Light, p: vec3<f32>, u: vec2<f32>) -> LightSample {
+    let qp = quad_from(l, p);
+    let q = qp.q;
     let c = cross(q.edge_u, q.edge_v);
     let area = length(c);
     if (!(area > 0.0)) { return no_light_sample(); }
     let y = q.corner + u.x * q.edge_u + u.y * q.edge_v;
-    let emitted = material_emission(scene_material(q.material), u);
-    return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted, make_prim(PRIM_QUAD, prim));
+    let emitted = material_emission(scene_material(q.material), select(u, u.yx, qp.swapped));
+    return area_to_solid_angle(p, y, c / area, 1.0 / area, emitted, make_prim(PRIM_QUAD, l.prim));
 }
 
 /// Uniform in solid angle (spherical rectangle, Ureña et al. 2013) where `quad_frame` allows, else by area.
 fn quad_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
-    let q = scene_quad(l.prim);
+    let qp = quad_from(l, p);
+    let q = qp.q;
     let f = quad_frame(q, p);
     if (f.m.measure != MEASURE_SOLID_ANGLE) {
-        var s = quad_sample_area(l.prim, p, u.xy);
+        var s = quad_sample_area(l, p, u.xy);
         s.m = f.m;
         return s;
     }
@@ -283,7 +325,7 @@ fn quad_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
     let v = xy.x * f.x + xy.y * f.y - f.rect.h * f.z;
     let dist = length(v);
     let st = vec2<f32>((xy.x - f.rect.x0) / f.lu, (xy.y - f.rect.y0) / f.lv);
-    let emitted = material_emission(scene_material(q.material), st);
+    let emitted = material_emission(scene_material(q.material), select(st, st.yx, qp.swapped));
     return LightSample(v / dist, dist, emitted, 1.0 / f.rect.omega, f.m, make_prim(PRIM_QUAD, l.prim));
 }
 
@@ -298,7 +340,7 @@ fn quad_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f
     return dot(v, v) / c;
 }
 
-fn quad_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(y); }
+fn quad_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(l, y); }
 
 // ---- LIGHT_SPHERE: an emissive sphere ----
 
@@ -375,7 +417,7 @@ fn sphere_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3
     return dot(v, v) / (l.area * cos_l);
 }
 
-fn sphere_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(y); }
+fn sphere_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(l, y); }
 
 // ---- LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL: delta lights (light sampling alone finds them) ----
 

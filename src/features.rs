@@ -53,6 +53,8 @@ pub struct Features {
     pub diffuse_transmission: bool,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
+    /// Any triangle with a cut-out mask (shaders/alpha.wgsl): the traversal tests alpha at triangle hits.
+    pub alpha: bool,
     /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
     /// (src/baked.rs): every primitive tested, unrolled, with its data as literals, instead of a BVH walk (no
     /// stack, no divergent traversal, no buffer reads). None = BVH.
@@ -82,6 +84,7 @@ impl Features {
             dielectric: true,
             diffuse_transmission: true,
             many_lights: true,
+            alpha: true,
             flat: None,
             baked: 0,
         }
@@ -92,6 +95,7 @@ impl Features {
         // The metallic-roughness materials (other kinds have their own constants).
         let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
         let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
+        let alpha = data.tri_shading.iter().any(|t| t.alpha_texture != 0);
         let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
             (false, _) => EnvKind::None,
             (true, false) => EnvKind::Constant,
@@ -114,7 +118,9 @@ impl Features {
             dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
             diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
             many_lights: data.lights.len() > 1,
-            flat: crate::baked::flat_counts(data),
+            alpha,
+            // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
+            flat: crate::baked::flat_counts(data).filter(|_| !alpha),
             baked: crate::baked::scene_data_source(data).map_or(0, |src| {
                 use std::hash::{Hash, Hasher};
                 let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -144,6 +150,7 @@ impl Features {
             ("HAS_DIELECTRIC", b(self.dielectric)),
             ("HAS_DIFFUSE_TRANSMISSION", b(self.diffuse_transmission)),
             ("MANY_LIGHTS", b(self.many_lights)),
+            ("HAS_ALPHA", b(self.alpha)),
             ("FLAT_SCENE", b(self.flat.is_some())),
         ]
     }
@@ -171,6 +178,7 @@ impl Features {
         on("dielectric (Fresnel reflection and refraction)", self.dielectric);
         on("diffuse transmission", self.diffuse_transmission);
         on("light selection", self.many_lights);
+        on("alpha cut-outs", self.alpha);
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));
         }

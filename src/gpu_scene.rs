@@ -91,6 +91,11 @@ impl SceneData {
             d.materials.push(gpu_material(&Default::default()));
         }
         let mat_index = |m: u32| if (m as usize) < d.materials.len() { m } else { 0 };
+        // A cut-out mask is read per triangle during traversal (shaders/alpha.wgsl): 0 = none, else texture + 1.
+        let alpha_of = |m: u32| {
+            let t = scene.materials.get(m as usize).and_then(|m| m.alpha_texture);
+            t.filter(|&t| (t as usize) < scene.textures.len()).map_or(0, |t| t + 1)
+        };
         let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
         for mesh in &scene.meshes {
             for t in &mesh.indices {
@@ -110,6 +115,7 @@ impl SceneData {
                     uv2: uv[2].into(),
                     material: mat_index(mesh.material),
                     light: INVALID,
+                    alpha_texture: alpha_of(mesh.material),
                     ..Default::default()
                 });
             }
@@ -322,6 +328,9 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
         let gm = &d.materials[m as usize];
         gm.emission.iter().any(|&c| c > 0.0)
     };
+    // Faces that emit: 2 for a two-sided area emitter.
+    let two_sided =
+        |m: u32| if scene.materials.get(m as usize).is_some_and(|m| m.emission_two_sided) { 2u32 } else { 1 };
     for (i, t) in tris.iter().enumerate() {
         let m = d.tri_shading[i].material;
         if !emits(m) {
@@ -332,8 +341,11 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
             continue;
         }
         d.tri_shading[i].light = lights.len() as u32;
-        power.push(PI * area as f64 * luminance(d.materials[m as usize].emission));
-        lights.push(GpuLight { kind: LIGHT_TRIANGLE, prim: i as u32, area, ..Default::default() });
+        // A two-sided emitter radiates π·A·L from each face.
+        let sides = two_sided(m);
+        power.push(PI * area as f64 * luminance(d.materials[m as usize].emission) * sides as f64);
+        let two_sided = (sides == 2) as u32;
+        lights.push(GpuLight { kind: LIGHT_TRIANGLE, prim: i as u32, area, two_sided, ..Default::default() });
     }
     for i in 0..d.spheres.len() {
         let s = d.spheres[i];
@@ -352,8 +364,10 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
             continue;
         }
         d.quads[i].light = lights.len() as u32;
-        power.push(PI * area as f64 * luminance(d.materials[q.material as usize].emission));
-        lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, ..Default::default() });
+        let sides = two_sided(q.material);
+        power.push(PI * area as f64 * luminance(d.materials[q.material as usize].emission) * sides as f64);
+        let two_sided = (sides == 2) as u32;
+        lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, two_sided, ..Default::default() });
     }
     let r = scene_radius(d);
     // Lights with a position first, then the infinite ones (directional, environment): the light tree covers
@@ -442,8 +456,9 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     d.light_alias = table.entries;
 }
 
-/// Where light `l` (of power `power`) is and emits, for the light tree: area emitters are one-sided (their front
-/// is the side `*_sample_li` accepts), spheres and point lights emit everywhere, spots into their outer cone.
+/// Where light `l` (of power `power`) is and emits, for the light tree: area emitters emit from their front (the
+/// side `*_sample_li` accepts) or, two-sided, from both faces; spheres and point lights emit everywhere, spots
+/// into their outer cone.
 fn light_bounds(l: &GpuLight, power: f64, tris: &[[Vec3; 3]], d: &SceneData) -> LightBounds {
     let everywhere = |lo: Vec3, hi: Vec3| LightBounds {
         lo,
@@ -457,7 +472,12 @@ fn light_bounds(l: &GpuLight, power: f64, tris: &[[Vec3; 3]], d: &SceneData) -> 
     let facing = |pts: &[Vec3], normal: Vec3| {
         let lo = pts.iter().fold(Vec3::splat(f32::MAX), |a, &p| a.min(p));
         let hi = pts.iter().fold(Vec3::splat(f32::MIN), |a, &p| a.max(p));
-        LightBounds { axis: normal.normalize_or(Vec3::Z), cos_o: 1.0, ..everywhere(lo, hi) }
+        LightBounds {
+            axis: normal.normalize_or(Vec3::Z),
+            cos_o: 1.0,
+            two_sided: l.two_sided != 0,
+            ..everywhere(lo, hi)
+        }
     };
     match l.kind {
         LIGHT_TRIANGLE => {

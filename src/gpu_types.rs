@@ -66,7 +66,8 @@ pub struct GpuTriShading {
     pub n1: [f32; 3],
     pub light: u32,
     pub n2: [f32; 3],
-    pub _pad0: u32,
+    /// Cut-out mask: 0 none, k + 1 the texture k whose alpha channel is the coverage (shaders/alpha.wgsl).
+    pub alpha_texture: u32,
     pub uv0: [f32; 2],
     pub uv1: [f32; 2],
     pub uv2: [f32; 2],
@@ -126,7 +127,8 @@ pub struct GpuLight {
     pub pmf_uniform: f32,
     /// Its path in the light tree (`light_tree::LightTree::trails`; 0 for lights outside it).
     pub tree_trail: u32,
-    pub _pad0: u32,
+    /// 1: an area light emitting from both faces (triangles and quads).
+    pub two_sided: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }

@@ -9,6 +9,7 @@ pub mod bindings;
 pub mod bvh;
 pub mod chi2;
 pub mod cli_values;
+pub mod compare;
 pub mod convex_solids;
 pub mod exr_image;
 pub mod features;

@@ -38,6 +38,8 @@ enum Command {
     Reference(mislab::reference::ReferenceArgs),
     /// Combine the state files of `render --part K/N` runs into one image and state; --status DIR reports progress.
     Merge(mislab::state::merge::MergeArgs),
+    /// Compare an image with a reference: mean ratio and relMSE of N×N-block means, per channel.
+    Compare(mislab::compare::CompareArgs),
     /// Run time against error: configurations × spp ladder × seeds, CSV/JSON and plots.
     Bench(mislab::bench::BenchArgs),
     /// Open the interactive viewer: the image converges while a panel switches estimators live.
@@ -121,6 +123,7 @@ fn main() -> ExitCode {
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
         Command::Reference(args) => mislab::reference::run(&args).map_err(bad),
         Command::Merge(args) => mislab::state::merge::run(&args).map_err(bad),
+        Command::Compare(args) => mislab::compare::run(&args).map_err(bad),
         Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
         Command::Stress { filter } => stress(filter.as_deref()),
         Command::Figure(args) => mislab::figure::run(&args).map(|_| 0).map_err(bad),

@@ -37,12 +37,12 @@ pub struct ReferenceArgs {
     /// Render for this many seconds instead (after compilation; this or --spp is required).
     #[arg(long, value_parser = crate::cli_values::seconds)]
     pub time: Option<f64>,
-    /// Image width.
-    #[arg(long, default_value_t = 512)]
-    pub width: u32,
-    /// Image height.
-    #[arg(long, default_value_t = 512)]
-    pub height: u32,
+    /// Image width [default: the scene file's Film / hdrfilm size, else 512].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height [default: the scene file's Film / hdrfilm size, else 512].
+    #[arg(long)]
+    pub height: Option<u32>,
     /// direct or path.
     #[arg(long, value_enum, default_value_t = Mode::Direct)]
     pub mode: Mode,
@@ -210,6 +210,18 @@ pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
     crate::exr_image::read(path)
 }
 
+/// The image size from --width/--height and the scene's Film size: a flag given wins; with neither given the
+/// scene's size is used (with a note); one flag alone keeps the other at 512 (it is not derived from the aspect).
+pub fn film_size(width: Option<u32>, height: Option<u32>, scene: Option<[u32; 2]>) -> [u32; 2] {
+    match (width, height, scene) {
+        (None, None, Some([w, h])) => {
+            eprintln!("note: image size {w}x{h} from the scene file (--width/--height override it)");
+            [w, h]
+        }
+        (w, h, _) => [w.unwrap_or(512), h.unwrap_or(512)],
+    }
+}
+
 /// Runs `mislab reference`; returns the exit code (0, or 130 when interrupted after writing what it had).
 pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
@@ -225,9 +237,12 @@ pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
         (None, Some(t)) => return Err(format!("--time {t} must be a positive number of seconds")),
         (None, None) => return Err("give --spp N or --time SECONDS".into()),
     };
+    // The scene first: a bad file is reported without waiting for a device, and its Film size is the default.
+    let scene = args.scene.load()?;
+    let [width, height] = film_size(args.width, args.height, scene.film_size);
     let base = Settings {
-        width: args.width,
-        height: args.height,
+        width,
+        height,
         mode: args.mode,
         max_depth: args.max_depth,
         light_sampling: args.light_sampling,
@@ -245,14 +260,14 @@ pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
     }
     let ctx = GpuContext::new().map_err(|e| e.to_string())?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
-    let scene = args.scene.load()?;
     let t = Instant::now();
     let data = SceneData::build(&scene);
     let scene_hash = crate::state::scene_hash(&data, &scene.camera);
     let total = args.spp.unwrap_or(0);
     let range = args.part.map_or((0, total), |(k, n)| crate::state::session::part_range(k, n, total));
     let budget = if args.part.is_some() { Budget::Samples(range.1 - range.0) } else { budget };
-    if range.0 == range.1 {
+    // (Without --part a --time budget has no sample count: the range is unused.)
+    if args.part.is_some() && range.0 == range.1 {
         return Err(format!("--part of --spp {total} holds no samples (use at most {total} parts)"));
     }
     let (film, stats) = render_reference_from(&ctx, data, &scene, &settings, budget, 0, range.0, &stop)?;

@@ -34,6 +34,7 @@ pub const RENDER_FILES: &[&str] = &[
     "bsdf_diffuse_transmission.wgsl",
     "bsdf.wgsl",
     "surface.wgsl",
+    "alpha.wgsl",
     "lights.wgsl",
     "light_tree.wgsl",
     "mis.wgsl",

@@ -17,6 +17,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("bsdf_diffuse_transmission.wgsl", include_str!("../shaders/bsdf_diffuse_transmission.wgsl")),
     ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
+    ("alpha.wgsl", include_str!("../shaders/alpha.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("light_tree.wgsl", include_str!("../shaders/light_tree.wgsl")),
     ("mis.wgsl", include_str!("../shaders/mis.wgsl")),

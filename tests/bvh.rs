@@ -88,7 +88,12 @@ fn probe_spawn(s: ProbeSpawn) -> ProbeSpawnOut {
 ";
 
 fn probe_source() -> String {
-    mislab::shaders::compose(&["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "baked_geometry.wgsl"], PROBE_WGSL)
+    // Geometry only: no textures, so no cut-outs (alpha.wgsl needs the shading bindings).
+    let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
+    mislab::shaders::compose(
+        &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "baked_geometry.wgsl"],
+        &format!("{no_alpha}{PROBE_WGSL}"),
+    )
 }
 
 struct Geometry {

@@ -41,7 +41,7 @@ fn shared_structs_match() {
     let m = module();
     check!(m, "Sphere", GpuSphere, [center, radius, material, light, _pad0, _pad1]);
     check!(m, "Quad", GpuQuad, [corner, material, edge_u, light, edge_v, _pad0]);
-    check!(m, "TriShading", GpuTriShading, [n0, material, n1, light, n2, _pad0, uv0, uv1, uv2, _pad1]);
+    check!(m, "TriShading", GpuTriShading, [n0, material, n1, light, n2, alpha_texture, uv0, uv1, uv2, _pad1]);
     check!(
         m,
         "Material",
@@ -83,7 +83,7 @@ fn shared_structs_match() {
             area,
             pmf_uniform,
             tree_trail,
-            _pad0,
+            two_sided,
             _pad1,
             _pad2
         ]

@@ -50,10 +50,10 @@ pub struct BenchArgs {
     /// direct or path.
     #[arg(long, value_enum, default_value_t = Mode::Direct)]
     pub mode: Mode,
-    /// Image width (default 512; 128 for --suite).
+    /// Image width (default: the scene file's Film size, else 512; 128 for --suite).
     #[arg(long)]
     pub width: Option<u32>,
-    /// Image height (default 512; 128 for --suite).
+    /// Image height (default: the scene file's Film size, else 512; 128 for --suite).
     #[arg(long)]
     pub height: Option<u32>,
     /// Maximum path length (path mode).
@@ -138,6 +138,7 @@ impl BenchArgs {
                 mode: self.mode,
                 width: self.width.unwrap_or(512),
                 height: self.height.unwrap_or(512),
+                scene_film_size: self.width.is_none() && self.height.is_none(),
                 max_depth: self.max_depth,
                 spp: ladder.clone().unwrap_or_else(|| DEFAULT_LADDER.to_vec()),
                 time: self.time,

@@ -33,6 +33,10 @@ pub struct BenchGroup {
     pub width: u32,
     /// Film height.
     pub height: u32,
+    /// Use the scene file's Film / hdrfilm size instead of width × height where it has one (the command
+    /// line without --width/--height; not in TOML files, whose groups always say their size or take 512).
+    #[serde(skip)]
+    pub scene_film_size: bool,
     /// Maximum path length.
     pub max_depth: u32,
     /// spp ladder (ignored with `time`).
@@ -76,6 +80,7 @@ impl Default for BenchGroup {
             mode: Mode::Direct,
             width: 512,
             height: 512,
+            scene_film_size: false,
             max_depth: 8,
             spp: DEFAULT_LADDER.to_vec(),
             time: None,

@@ -100,6 +100,15 @@ fn group_reference(
 
 pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResult, String> {
     let scene = g.scene_spec().load()?;
+    let sized;
+    let g = match (g.scene_film_size, scene.film_size) {
+        (true, Some([width, height])) => {
+            eprintln!("note: image size {width}x{height} from the scene file (--width/--height override it)");
+            sized = BenchGroup { width, height, ..g.clone() };
+            &sized
+        }
+        _ => g,
+    };
     let (reference, ref_name) = group_reference(ctx, g, &scene, refs)?;
     let configs = g.configurations();
     let data = SceneData::build(&scene);

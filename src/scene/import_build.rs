@@ -15,8 +15,11 @@ pub struct Builder {
     pub scene: Scene,
     /// Material descriptions, indexed by shapes.
     pub descs: Vec<MaterialDesc>,
-    mapped: HashMap<(usize, [u32; 3]), Option<u32>>,
+    mapped: HashMap<(usize, [u32; 3], bool), Option<u32>>,
     textures: TextureCache,
+    /// Cut-out masks by file, and materials with a mask: (material, mask) → the masked copy.
+    masks: HashMap<std::path::PathBuf, u32>,
+    masked: HashMap<(u32, u32), u32>,
     /// Approximation warnings (one per material).
     pub warnings: Vec<String>,
     /// Ignored features: what → how often.
@@ -55,9 +58,10 @@ impl Builder {
         self.descs.push(desc);
         self.descs.len() - 1
     }
-    /// The scene material for description `desc` emitting `emission` (None: leave the shape out).
-    pub fn material(&mut self, desc: usize, emission: Vec3) -> Result<Option<u32>, SceneError> {
-        let key = (desc, emission.to_array().map(f32::to_bits));
+    /// The scene material for description `desc` emitting `emission`, from both faces when `two_sided` (None:
+    /// leave the shape out).
+    pub fn material(&mut self, desc: usize, emission: Vec3, two_sided: bool) -> Result<Option<u32>, SceneError> {
+        let key = (desc, emission.to_array().map(f32::to_bits), two_sided);
         if let Some(m) = self.mapped.get(&key) {
             return Ok(*m);
         }
@@ -68,12 +72,14 @@ impl Builder {
             Mapped::Invisible if emission.max_element() > 0.0 => {
                 let mut m = super::Material::emitter(&self.descs[desc].name, emission);
                 m.name = format!("{} (emitter)", self.descs[desc].name);
+                m.emission_two_sided = two_sided;
                 self.scene.materials.push(m);
                 Some(self.scene.materials.len() as u32 - 1)
             }
             Mapped::Invisible => None,
             Mapped::Material(mut m) => {
                 m.emission = emission;
+                m.emission_two_sided = two_sided && emission.max_element() > 0.0;
                 self.scene.materials.push(*m);
                 Some(self.scene.materials.len() as u32 - 1)
             }
@@ -83,6 +89,49 @@ impl Builder {
         }
         self.mapped.insert(key, m);
         Ok(m)
+    }
+
+    /// The cut-out mask of image `file` (a texture whose alpha channel is the coverage, shaders/alpha.wgsl): the
+    /// image's alpha channel where it has one that is not all opaque, else its first channel (pbrt-v4's float
+    /// texel). A leaf texture with transparent surroundings cuts them out either way.
+    pub fn alpha_mask(&mut self, file: &std::path::Path) -> Result<u32, SceneError> {
+        if let Some(&t) = self.masks.get(file) {
+            return Ok(t);
+        }
+        let (width, height, mut texels) = super::import_texture::load_rgba8(file, false)?;
+        if texels.iter().all(|c| c[3] == 255) {
+            for c in &mut texels {
+                c[3] = c[0];
+            }
+        }
+        self.scene.textures.push(super::Texture {
+            name: format!("{} (alpha mask)", file.display()),
+            width,
+            height,
+            texels,
+            srgb: false,
+            wrap_s: super::Wrap::Repeat,
+            wrap_t: super::Wrap::Repeat,
+            nearest: false,
+        });
+        let t = self.scene.textures.len() as u32 - 1;
+        self.masks.insert(file.to_path_buf(), t);
+        self.count("alpha cut-out masks", 1);
+        Ok(t)
+    }
+
+    /// Scene material `material` with cut-out mask `mask` (a copy per pair).
+    pub fn masked_material(&mut self, material: u32, mask: u32) -> u32 {
+        if let Some(&m) = self.masked.get(&(material, mask)) {
+            return m;
+        }
+        let mut m = self.scene.materials[material as usize].clone();
+        m.alpha_texture = Some(mask);
+        m.name = format!("{} (cut-out)", m.name);
+        self.scene.materials.push(m);
+        let i = self.scene.materials.len() as u32 - 1;
+        self.masked.insert((material, mask), i);
+        i
     }
 
     /// Places `mesh` with `to_world`. Triangles face their vertex normals when there are any; otherwise they

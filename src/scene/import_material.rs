@@ -146,10 +146,16 @@ pub fn map(
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
             match (conductor_eta_k(desc), t) {
                 // RGB or named η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
-                (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => Material {
-                    kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av },
-                    ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
-                },
+                (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => {
+                    // Mitsuba's specular_reflectance scales the Fresnel term; the conductor kind has no tint yet.
+                    if c != Vec3::ONE {
+                        warn("a complex-Fresnel conductor without its specular_reflectance tint (rendered as 1)");
+                    }
+                    Material {
+                        kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av },
+                        ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
+                    }
+                }
                 // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
                 // normal-incidence reflectance, named_spectra): the complex-Fresnel conductor of that F(0).
                 (_, None) => {

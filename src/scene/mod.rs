@@ -240,6 +240,11 @@ pub struct Material {
     pub specular: f32,
     /// Emitted radiance (emissiveFactor × emissive_strength).
     pub emission: Vec3,
+    /// Emission from both faces (pbrt `AreaLightSource "bool twosided"`); otherwise from the front only.
+    pub emission_two_sided: bool,
+    /// Cut-out mask (pbrt `"float alpha"` texture): index into `Scene::textures` whose alpha channel (linear) is the
+    /// coverage; a triangle point with coverage below 0.5 is a hole that every ray passes through.
+    pub alpha_texture: Option<u32>,
     /// Base colour texture (sRGB).
     pub base_color_texture: Option<TextureRef>,
     /// Metallic (B) / roughness (G) texture (linear).
@@ -258,6 +263,8 @@ impl Default for Material {
             roughness: 1.0,
             specular: 1.0,
             emission: Vec3::ZERO,
+            emission_two_sided: false,
+            alpha_texture: None,
             base_color_texture: None,
             metallic_roughness_texture: None,
             emissive_texture: None,

@@ -385,7 +385,8 @@ impl Loader {
                 return Ok(());
             }
         };
-        let Some(m) = self.b.material(material, emission)? else {
+        // Mitsuba 3's area emitter is one-sided (its `twosided` adapter wraps BSDFs, not emitters).
+        let Some(m) = self.b.material(material, emission, false)? else {
             self.b.invisible_shapes += 1;
             return Ok(());
         };

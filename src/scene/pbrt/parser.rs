@@ -29,6 +29,7 @@ const ENV_HEIGHT: u32 = 512;
 #[derive(Clone)]
 struct AreaLight {
     radiance: Vec3,
+    two_sided: bool,
 }
 
 #[derive(Clone)]
@@ -358,10 +359,8 @@ impl Parser {
                 } else {
                     let l = self.spectrum(&p, "L", Vec3::ONE)?;
                     let scale = p.float("scale", 1.0)?;
-                    if p.bool("twosided", false)? {
-                        self.b.ignore("AreaLightSource \"twosided\" (emits from the front only)");
-                    }
-                    self.gs.area = Some(AreaLight { radiance: l * scale });
+                    let two_sided = p.bool("twosided", false)?;
+                    self.gs.area = Some(AreaLight { radiance: l * scale, two_sided });
                 }
             }
             "LightSource" => self.light(kind, &p)?,
@@ -412,7 +411,7 @@ impl Parser {
         }
     }
 
-    fn texture(&mut self, name: &str, ty: &str, class: &str, p: &Params) -> Result<(), SceneError> {
+    fn texture(&mut self, name: &str, _ty: &str, class: &str, p: &Params) -> Result<(), SceneError> {
         let value = match class {
             "imagemap" => {
                 let file = p
@@ -433,10 +432,6 @@ impl Parser {
                     self.b.ignore(format!("Texture \"{name}\" \"bool invert\""));
                 }
                 p.has("filter");
-                if ty == "float" {
-                    // Float image textures are used as alpha masks (leaves); cut-outs are not supported yet.
-                    self.b.ignore(format!("float image texture \"{name}\" (alpha cut-outs are not supported)"));
-                }
                 // Stored with v down; our add_mesh already flips v, so the pbrt map (us·u+ud, vs·v+vd) becomes
                 // u' = us·u + ud, v' = vs·v' − vs + 1 − vd in terms of the flipped v' = 1 − v.
                 let uv = [[us, 0.0, ud], [0.0, vs, 1.0 - vs - vd]];
@@ -598,8 +593,28 @@ impl Parser {
     fn shape(&mut self, s: ShapeCall) -> Result<(), SceneError> {
         let p = &*s.params;
         let emission = s.area.as_ref().map_or(Vec3::ZERO, |a| a.radiance);
-        if p.has("alpha") {
-            self.b.ignore("shape \"alpha\" cut-outs");
+        // Cut-outs: a float texture (its image is the mask) or a constant (0 = the shape is invisible).
+        let mut mask = None;
+        match p.type_of("alpha") {
+            Some("texture") => {
+                let name = p.string_of("alpha", &["texture"])?.expect("present");
+                match self.textures.get(&name) {
+                    Some(MatParam::Texture(t)) => {
+                        if t.uv != [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+                            self.b.ignore("uscale/vscale/udelta/vdelta of alpha textures (the mask uses the mesh uv)");
+                        }
+                        let file = t.file.clone();
+                        mask = Some(self.b.alpha_mask(&file)?);
+                    }
+                    Some(_) => self.b.ignore("non-image alpha textures (opaque)"),
+                    None => return Err(p.error(format!("\"texture alpha\" \"{name}\": no such texture"))),
+                }
+            }
+            Some(_) if p.float("alpha", 1.0)? < 0.5 => {
+                self.b.count("shapes cut out by \"float alpha\" 0", 1);
+                return Ok(());
+            }
+            _ => {}
         }
         let to_world = (MIRROR * s.ctm).as_mat4();
         let flip = s.reverse ^ (Mat3::from_mat4(to_world).determinant() < 0.0);
@@ -624,9 +639,18 @@ impl Parser {
                 return Ok(());
             }
         };
-        let Some(material) = self.b.material(s.material, emission)? else {
+        let two_sided = s.area.as_ref().is_some_and(|a| a.two_sided);
+        let Some(material) = self.b.material(s.material, emission, two_sided)? else {
             self.b.invisible_shapes += 1;
             return Ok(());
+        };
+        let material = match mask {
+            Some(t) if s.kind != "sphere" => self.b.masked_material(material, t),
+            Some(_) => {
+                self.b.ignore("alpha cut-outs on spheres (rendered opaque)");
+                material
+            }
+            None => material,
         };
         match mesh {
             Some(m) => self.b.add_mesh(m, to_world, flip, material),

@@ -1,0 +1,20 @@
+// alpha.wgsl — cut-outs (pbrt `"float alpha"` textures: leaves): a triangle point whose mask coverage is below 0.5
+// is a hole; traversal (bvh.wgsl) skips it for closest hits and shadow rays alike, so light and camera rays agree.
+//
+// A fixed threshold, not pbrt-v4's stochastic alpha (a hash decides per ray, with probability = coverage): the masks of
+// these scenes are binary (0 or 1 nearly everywhere), where both give the same image, and a threshold adds no noise
+// and keeps the shadow and closest-hit queries of one point consistent. Fractional coverage is rounded, not blended.
+
+/// Coverage below this is a hole.
+const ALPHA_CUTOFF: f32 = 0.5;
+
+/// Whether the hit at barycentrics (b1, b2) of primitive `prim` lies in a cut-out. Triangles only.
+fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool {
+    if (prim_kind(prim) != PRIM_TRIANGLE) { return false; }
+    let sh = scene_tri_shading(prim_index(prim));
+    if (sh.alpha_texture == 0u) { return false; }
+    let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
+    // The mask's own uv: identity (the importer warns about uv scale/offset on a mask).
+    let c = texture_lookup(sh.alpha_texture - 1u, vec4<f32>(1.0, 0.0, 0.0, 0.0), vec4<f32>(0.0, 1.0, 0.0, 0.0), uv);
+    return c.w < ALPHA_CUTOFF;
+}
