@@ -250,11 +250,24 @@ pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("state")) {
         return crate::state::RenderState::read(path).map(|s| s.reference_image());
     }
-    let img = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.into_rgb32f();
+    // Only linear float data is a reference: an 8-bit PNG or JPEG is tonemapped and clipped, and relMSE against it
+    // would be silently meaningless.
+    let bytes = crate::input_file::read_bounded(path, crate::input_file::MAX_ENVMAP_BYTES)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        return Err(format!(
+            "{}: not an OpenEXR file; a reference must be linear EXR (e.g. from `mislab reference`) or a .state, \
+             not a tonemapped 8-bit image",
+            path.display()
+        ));
+    }
+    let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::OpenExr)
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .into_rgb32f();
     let (width, height) = img.dimensions();
     let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
     let mut attributes = BTreeMap::new();
-    if let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) {
+    if let Ok(meta) = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false) {
         if let Some(header) = meta.headers.first() {
             for (k, v) in &header.own_attributes.other {
                 if let exr::meta::attribute::AttributeValue::Text(t) = v {

@@ -754,6 +754,27 @@ fn bench_end_to_end_from_flags() {
         assert!(dir.join(f).exists(), "{f} missing");
     }
     assert!(std::fs::read_dir(dir.join("refs")).unwrap().count() == 1, "the reference is cached");
+    // Every row counts its NaN/Inf samples; the reference's spp is the real one.
+    assert!(rows.iter().all(|r| r[col("nonfinite_samples")] == "0"), "NaN/Inf counts per row");
+    assert_eq!(json["groups"][0]["reference_spp"], 256);
+    assert_eq!(json["groups"][0]["group"]["reference_spp"], 256);
+    assert!(std::fs::read_to_string(dir.join("summary.md")).unwrap().contains("(256 spp)"));
+    // A given reference: its header's spp is reported, whatever --ref-spp says; an 8-bit PNG is refused.
+    let cached = std::fs::read_dir(dir.join("refs")).unwrap().next().unwrap().unwrap().path();
+    let again = dir.join("again").to_string_lossy().into_owned();
+    let with_ref = |r: &std::path::Path, out: &str| {
+        let r = r.to_string_lossy().into_owned();
+        let args = ["bench", "veach-mis", "--width", "24", "--height", "16", "--spp", "2", "--seeds", "1"];
+        BenchCli::parse_from(args.into_iter().chain(["--ref", &r, "--ref-spp", "4096", "--out", out]))
+    };
+    mislab::bench::run(&with_ref(&cached, &again).args).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("again/results.json")).unwrap()).unwrap();
+    assert_eq!(json["groups"][0]["reference_spp"], 256, "the given file's spp, not --ref-spp");
+    let png = dir.join("ref.png");
+    image::RgbImage::new(24, 16).save(&png).unwrap();
+    let e = mislab::bench::run(&with_ref(&png, &again).args).unwrap_err();
+    assert!(e.contains("not an OpenEXR file"), "{e}");
 }
 
 /// A TOML configuration with two groups, one reading the reference the other wrote.
