@@ -651,6 +651,34 @@ fn sampler_figure_and_spectra() {
     assert!(run(&dir.join("samplers.jpg"), 1500, 1000).is_err());
 }
 
+/// `mislab figure samplers` follows --spp and --seed (a different figure for each) and says what it wrote.
+#[test]
+fn figure_samplers_follows_spp_and_seed_and_reports() {
+    let dir = scratch("figure-cli");
+    let figure = |spp: &str, seed: &str, name: &str| {
+        let out = dir.join(name);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mislab"))
+            .args(["figure", "samplers", "--width", "40", "--height", "50", "--spp", spp, "--seed", seed, "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        (o.status.code(), err, out)
+    };
+    let (code, err, a) = figure("16", "0", "a.png");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("wrote") && err.contains("16 points per sampler") && err.contains("seed 0"), "{err}");
+    let (_, _, b) = figure("16", "3", "b.png");
+    let (_, _, c) = figure("4", "0", "c.png");
+    let img = |p: &std::path::Path| image::open(p).unwrap().into_rgb8();
+    assert_eq!(img(&a).dimensions(), (240, 200));
+    assert_ne!(img(&a), img(&b), "--seed must change the figure");
+    assert_ne!(img(&a), img(&c), "--spp must change the figure");
+    let (code, err, _) = figure("5000", "0", "d.png");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("1 to 1024"), "{err}");
+}
+
 /// A reference's EXR header records its sample count and settings, and the pixels survive the round trip.
 #[test]
 fn reference_exr_records_spp_and_settings() {
