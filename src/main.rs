@@ -35,6 +35,8 @@ enum Command {
     /// Render a scene progressively to PNG (tonemapped) or EXR (linear radiance).
     Render(RenderArgs),
     /// Render a high-quality reference (MIS, Sobol) to EXR; the header records spp and settings.
+    // clap's own usage line would show --spp as required and hide --time, its equal alternative.
+    #[command(override_usage = "mislab reference [SCENE] -o <OUTPUT> (--spp <N> | --time <SECONDS>) [OPTIONS]")]
     Reference(mislab::reference::ReferenceArgs),
     /// Combine the state files of `render --part K/N` runs into one image and state; --status DIR reports progress.
     Merge(mislab::state::merge::MergeArgs),
