@@ -59,14 +59,26 @@ pub struct ReferenceImage {
     pub attributes: BTreeMap<String, String>,
 }
 
-/// Reads a linear image (an EXR from any writer, or any format `image` reads) and, where present, the text
-/// attributes `write` records.
+/// Reads a linear image from an OpenEXR file (any writer) and, where present, the text attributes `write`
+/// records. Anything else is refused: an 8-bit PNG or JPEG is tonemapped and clipped, and an error measured
+/// against it would be silently meaningless.
 pub fn read(path: &Path) -> Result<ReferenceImage, String> {
-    let img = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.into_rgb32f();
+    let bytes = crate::input_file::read_bounded(path, crate::input_file::MAX_ENVMAP_BYTES)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        return Err(format!(
+            "{}: not an OpenEXR file; a reference must be linear EXR (e.g. from `mislab reference`) or a .state, \
+             not a tonemapped 8-bit image",
+            path.display()
+        ));
+    }
+    let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::OpenExr)
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .into_rgb32f();
     let (width, height) = img.dimensions();
     let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
     let mut attributes = BTreeMap::new();
-    if let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) {
+    if let Ok(meta) = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false) {
         if let Some(header) = meta.headers.first() {
             for (k, v) in &header.own_attributes.other {
                 if let exr::meta::attribute::AttributeValue::Text(t) = v {

@@ -28,16 +28,17 @@ pub struct FigureArgs {
     /// Output PNG.
     #[arg(short, long, default_value = "figure.png")]
     pub output: PathBuf,
-    /// Samples per pixel of every panel (the same for all, as in the lecture).
-    #[arg(long, default_value_t = 64)]
-    pub spp: u32,
+    /// Samples per pixel of every panel (the same for all, as in the lecture; default 64). For samplers: the points
+    /// drawn per panel and the second spectrum row's spp (default 256 points, spectra at 1 and 4 spp).
+    #[arg(long)]
+    pub spp: Option<u32>,
     /// Width of one panel in pixels.
     #[arg(long, default_value_t = 256)]
     pub width: u32,
     /// Height of one panel in pixels.
     #[arg(long, default_value_t = 256)]
     pub height: u32,
-    /// Seed of every random number (the same for every panel).
+    /// Seed of every random number (the same for every panel; samplers: of the points and spectra).
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
     /// Seconds of rendering per panel, instead of --spp (the many-lights figure compares at equal time: 4 s
@@ -113,17 +114,28 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
 pub fn run(args: &FigureArgs) -> Result<(), String> {
     if args.which == "samplers" {
         // One column per sampler, four rows (two point sets, two spectra), each about a panel in size.
-        return crate::sampler_figure::run(
-            &args.output,
-            (args.width * 6).clamp(200, 16384),
-            (args.height * 4).clamp(200, 16384),
+        let options = match args.spp {
+            Some(n) => crate::sampler_figure::Options::with_spp(n, args.seed)?,
+            None => crate::sampler_figure::Options { seed: args.seed, ..Default::default() },
+        };
+        let (w, h) = ((args.width * 6).clamp(200, 16384), (args.height * 4).clamp(200, 16384));
+        crate::sampler_figure::run_with(&args.output, w, h, &options)?;
+        // Say what was written: a silent success reads like nothing happened.
+        eprintln!(
+            "wrote {} ({w}x{h}: {} points per sampler, spectra at {:?} spp, seed {})",
+            args.output.display(),
+            options.points,
+            options.spectrum_spp,
+            options.seed
         );
+        return Ok(());
     }
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("png") {
         return Err(format!("{}: figures are written as PNG (use a .png name)", args.output.display()));
     }
-    if args.spp == 0 {
+    let spp = args.spp.unwrap_or(64);
+    if spp == 0 {
         return Err("--spp must be at least 1".into());
     }
     let time = args.time.or((args.which == "many-lights").then_some(4.0));
@@ -144,14 +156,14 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
         renderer.set_settings(p.settings.clone())?;
         let film = match time {
             Some(t) => render_for(&ctx, &mut renderer, t)?,
-            None => render(&ctx, &mut renderer, args.spp)?,
+            None => render(&ctx, &mut renderer, spp)?,
         };
         let mut img = film.to_rgb8(p.settings.exposure, Tonemap::Clamp);
         let scale = if args.width >= 192 { 2 } else { 1 };
         draw_label(&mut img, 4, 4, p.label, scale);
         let budget = match time {
             Some(t) => format!("{t} s: {} spp", renderer.samples()),
-            None => format!("{} spp", args.spp),
+            None => format!("{spp} spp"),
         };
         draw_label(&mut img, 4, 4 + 9 * scale, &budget, scale);
         images.push(img);
@@ -166,7 +178,21 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
         let (cx, cy) = (k as u32 % columns, k as u32 / columns);
         image::imageops::replace(&mut out, img, (cx * (args.width + GAP)) as i64, (cy * (args.height + GAP)) as i64);
     }
-    save_png(&out, &args.output)
+    save_png(&out, &args.output)?;
+    let budget = match time {
+        Some(t) => format!("{t} s per panel"),
+        None => format!("{spp} spp per panel"),
+    };
+    eprintln!(
+        "wrote {} ({}x{}: {} panels of {} at {budget}, seed {})",
+        args.output.display(),
+        out.width(),
+        out.height(),
+        panels.len(),
+        scene_name,
+        args.seed
+    );
+    Ok(())
 }
 
 /// Renders whole samples per pixel until `seconds` of rendering have passed (the first pass is timed apart from

@@ -18,6 +18,9 @@ use std::time::{Duration, Instant};
 const EXIT_BAD_INPUT: u8 = 2;
 /// Exit code after Ctrl-C (the partial image is still written).
 const EXIT_INTERRUPTED: u8 = 130;
+/// What a signal during start-up (before any sample) leaves: nothing, said plainly.
+const STARTUP_INTERRUPTED: &str =
+    "interrupted during start-up, before any sample was rendered: no image was written (exit code 130)";
 
 #[derive(Parser)]
 #[command(
@@ -35,6 +38,8 @@ enum Command {
     /// Render a scene progressively to PNG (tonemapped) or EXR (linear radiance).
     Render(RenderArgs),
     /// Render a high-quality reference (MIS, Sobol) to EXR; the header records spp and settings.
+    // clap's own usage line would show --spp as required and hide --time, its equal alternative.
+    #[command(override_usage = "mislab reference [SCENE] -o <OUTPUT> (--spp <N> | --time <SECONDS>) [OPTIONS]")]
     Reference(mislab::reference::ReferenceArgs),
     /// Combine the state files of `render --part K/N` runs into one image and state; --status DIR reports progress.
     Merge(mislab::state::merge::MergeArgs),
@@ -201,10 +206,26 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     let interrupt = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupt.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+        let _ = ctrlc::set_handler(move || {
+            // A second signal while start-up (a long load or shader compile) has not yet looked at the first:
+            // stop now, and say why nothing was written.
+            if flag.swap(true, Ordering::SeqCst) {
+                eprintln!("{STARTUP_INTERRUPTED} (second signal)");
+                std::process::exit(EXIT_INTERRUPTED as i32);
+            }
+        });
     }
+    let startup_interrupted = || -> Option<u8> {
+        interrupt.load(Ordering::SeqCst).then(|| {
+            eprintln!("{STARTUP_INTERRUPTED}");
+            EXIT_INTERRUPTED
+        })
+    };
     // The scene first: a bad file is reported without waiting for (or needing) a device.
     let scene = load_scene(&args.scene)?;
+    if let Some(code) = startup_interrupted() {
+        return Ok(code);
+    }
     // A pbrt Film / Mitsuba hdrfilm size is the default: used when --width and --height are both left at theirs.
     let default = Settings::default();
     if let (Some([w, h]), true) =
@@ -215,6 +236,9 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     }
     let t_loaded = Instant::now();
     let ctx = gpu_context()?;
+    if let Some(code) = startup_interrupted() {
+        return Ok(code);
+    }
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
     let t_device = Instant::now();
     let data = SceneData::build(&scene);
@@ -257,9 +281,8 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         (t_device - t_loaded).as_secs_f64(),
         (t_ready - t_device).as_secs_f64()
     );
-    if interrupt.load(Ordering::SeqCst) {
-        eprintln!("interrupted during start-up: nothing was rendered and no image was written");
-        return Ok(EXIT_INTERRUPTED);
+    if let Some(code) = startup_interrupted() {
+        return Ok(code);
     }
     let bar = match budget {
         Budget::Samples(n) => indicatif::ProgressBar::new(n as u64),
@@ -283,6 +306,11 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     }
     .map_err(|e| bad(e.to_string()))?;
     bar.finish_and_clear();
+    if stats.interrupted && stats.spp == 0 {
+        // A signal between start-up's last check and the first whole sample: an empty image would be a lie.
+        eprintln!("{STARTUP_INTERRUPTED} (before the first sample per pixel)");
+        return Ok(EXIT_INTERRUPTED);
+    }
     if let Some(s) = &session {
         s.save(&ctx, &renderer, stats.seconds).map_err(bad)?;
         eprintln!("wrote state {} (samples {}..{})", s.path().display(), s.range().0, renderer.samples());

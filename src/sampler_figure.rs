@@ -99,12 +99,23 @@ fn disc(u: [f32; 2]) -> f64 {
 /// Mean power spectrum of the per-pixel error of the disc integrand at `spp`, over `SPECTRUM_SEEDS` seeds, and
 /// the error image of seed 0.
 pub fn error_spectrum(kind: SamplerKind, spp: u32) -> (Vec<f64>, Vec<f64>) {
+    error_spectrum_seeded(kind, spp, 0)
+}
+
+/// `error_spectrum` with the seeds shifted by `seed` × `SPECTRUM_SEEDS` (seed 0: the published figure's).
+pub fn error_spectrum_seeded(kind: SamplerKind, spp: u32, seed: u32) -> (Vec<f64>, Vec<f64>) {
     let side = SPECTRUM_SIZE;
     let exact = std::f64::consts::PI * 0.16;
     let mut sum = vec![0.0; side * side];
     let mut first = vec![];
+    let base = seed;
     for seed in 0..SPECTRUM_SEEDS {
-        let p = SamplerParams { kind, seed: 1000 + seed, sampler_spp: spp, width: side as u32 };
+        let p = SamplerParams {
+            kind,
+            seed: 1000u32.wrapping_add(base.wrapping_mul(SPECTRUM_SEEDS)).wrapping_add(seed),
+            sampler_spp: spp,
+            width: side as u32,
+        };
         let err: Vec<f64> = (0..(side * side) as u32)
             .map(|px| (0..spp).map(|i| disc(samplers::sample_2d(&p, px, i, 0))).sum::<f64>() / spp as f64 - exact)
             .collect();
@@ -141,10 +152,42 @@ pub fn low_frequency_ratio(spectrum: &[f64], side: usize) -> f64 {
     (low / nl as f64) / (all / na as f64).max(1e-300)
 }
 
+/// What `mislab figure samplers` shows: `--spp` and `--seed`.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Points of one pixel drawn per panel (its samples at this spp).
+    pub points: u32,
+    /// Sample counts of the spectrum rows.
+    pub spectrum_spp: Vec<u32>,
+    /// Seed of the points and (shifted per seed) of the spectra.
+    pub seed: u32,
+}
+
+impl Default for Options {
+    /// The published figure: 256 points, spectra at 1 and 4 spp, seed 0.
+    fn default() -> Self {
+        Options { points: POINTS, spectrum_spp: SPECTRUM_SPP.to_vec(), seed: 0 }
+    }
+}
+
+impl Options {
+    /// `--spp N`: N points per panel and spectra at 1 and N spp (N ≤ 1024: the spectra are computed on the CPU).
+    pub fn with_spp(spp: u32, seed: u32) -> Result<Options, String> {
+        if !(1..=1024).contains(&spp) {
+            return Err(format!("--spp {spp}: figure samplers shows 1 to 1024 samples per pixel"));
+        }
+        let spectrum_spp = if spp == 1 { vec![1] } else { vec![1, spp] };
+        Ok(Options { points: spp, spectrum_spp, seed })
+    }
+}
+
 struct SamplerFigure {
-    points: Vec<(Vec<[f32; 2]>, Vec<[f32; 2]>)>,
+    /// Per sampler: its point count (fixed-count samplers may round it) and the two point sets.
+    points: Vec<(u32, Vec<[f32; 2]>, Vec<[f32; 2]>)>,
     spectra: Vec<Vec<(Vec<f64>, usize, f64)>>,
+    spectrum_spp: Vec<u32>,
     spectrum_range: (f64, f64),
+    points_title: u32,
 }
 
 fn point_color(i: usize) -> RGBColor {
@@ -163,16 +206,19 @@ impl Figure for SamplerFigure {
         root.fill(&WHITE).map_err(err)?;
         let titled = root
             .titled(
-                "Samplers: first 256 points of one pixel (orange 1–16, green 17–64, blue 65–256) and error power spectra",
+                &format!(
+                    "Samplers: first {} points of one pixel (orange 1–16, green 17–64, blue 65–) and error power spectra",
+                    self.points_title
+                ),
                 ("sans-serif", 18),
             )
             .map_err(err)?;
         let cols = SamplerKind::ALL.len();
-        let rows = 2 + SPECTRUM_SPP.len();
+        let rows = 2 + self.spectrum_spp.len();
         let cells = titled.split_evenly((rows, cols));
         let row_names = ["jitter (0, 1)".to_string(), "light sample (dims 5, 6)".to_string()]
             .into_iter()
-            .chain(SPECTRUM_SPP.iter().map(|n| format!("error power spectrum, {n} spp")))
+            .chain(self.spectrum_spp.iter().map(|n| format!("error power spectrum, {n} spp")))
             .collect::<Vec<_>>();
         for (c, kind) in SamplerKind::ALL.iter().enumerate() {
             for r in 0..rows {
@@ -181,14 +227,20 @@ impl Figure for SamplerFigure {
                 let side = (aw.min(ah.saturating_sub(36)) as f64 - 8.0).max(8.0);
                 let x0 = (aw as f64 - side) / 2.0;
                 let y0 = 20.0;
-                let caption = if r == 0 { format!("{}: {}", kind.name(), row_names[r]) } else { row_names[r].clone() };
+                let caption = match r {
+                    0 if self.points[c].0 != self.points_title => {
+                        format!("{} ({} points): {}", kind.name(), self.points[c].0, row_names[r])
+                    }
+                    0 => format!("{}: {}", kind.name(), row_names[r]),
+                    _ => row_names[r].clone(),
+                };
                 area.draw(&Text::new(caption, (x0 as i32, 2), ("sans-serif", 12))).map_err(err)?;
                 let frame = Rectangle::new(
                     [(x0 as i32, y0 as i32), ((x0 + side) as i32, (y0 + side) as i32)],
                     BLACK.stroke_width(1),
                 );
                 if r < 2 {
-                    let pts = if r == 0 { &self.points[c].0 } else { &self.points[c].1 };
+                    let pts = if r == 0 { &self.points[c].1 } else { &self.points[c].2 };
                     for (i, p) in pts.iter().enumerate() {
                         let (px, py) = (x0 + p[0] as f64 * side, y0 + (1.0 - p[1] as f64) * side);
                         area.draw(&Circle::new(
@@ -227,8 +279,13 @@ impl Figure for SamplerFigure {
     }
 }
 
-/// Renders the figure to `output` (.png or .svg) at `width`×`height` pixels.
+/// Renders the published figure to `output` (.png or .svg) at `width`×`height` pixels.
 pub fn run(output: &Path, width: u32, height: u32) -> Result<(), String> {
+    run_with(output, width, height, &Options::default())
+}
+
+/// Renders the figure with `options` to `output` (.png or .svg) at `width`×`height` pixels.
+pub fn run_with(output: &Path, width: u32, height: u32, options: &Options) -> Result<(), String> {
     let ext = output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     if ext != "png" && ext != "svg" {
         return Err(format!("{}: the figure is written as .png or .svg", output.display()));
@@ -242,16 +299,19 @@ pub fn run(output: &Path, width: u32, height: u32) -> Result<(), String> {
     let mut spectra = vec![];
     let mut white = 0.0;
     for kind in SamplerKind::ALL {
-        let p = SamplerParams { kind: *kind, seed: 7, sampler_spp: POINTS, width: 64 };
+        // Fixed-count samplers build their points for the count (stratified rounds it to a grid it fits).
+        let n = samplers::check_spp(*kind, options.points)?;
+        let p = SamplerParams { kind: *kind, seed: 7u32.wrapping_add(options.seed), sampler_spp: n, width: 64 };
         let pixel = 2021;
-        let jitter = (0..POINTS).map(|i| samplers::sample_2d(&p, pixel, i, 0)).collect();
-        let light = (0..POINTS).map(|i| samplers::sample_2d(&p, pixel, i, DIMS_CAMERA + 1)).collect();
-        points.push((jitter, light));
+        let jitter = (0..n).map(|i| samplers::sample_2d(&p, pixel, i, 0)).collect();
+        let light = (0..n).map(|i| samplers::sample_2d(&p, pixel, i, DIMS_CAMERA + 1)).collect();
+        points.push((n, jitter, light));
         let mut row = vec![];
-        for spp in SPECTRUM_SPP {
-            let (s, _) = error_spectrum(*kind, spp);
+        for (k, &spp) in options.spectrum_spp.iter().enumerate() {
+            let spp = samplers::check_spp(*kind, spp)?;
+            let (s, _) = error_spectrum_seeded(*kind, spp, options.seed);
             let ratio = low_frequency_ratio(&s, SPECTRUM_SIZE);
-            if *kind == SamplerKind::Independent && spp == SPECTRUM_SPP[0] {
+            if *kind == SamplerKind::Independent && k == 0 {
                 // Normalise every panel to the white-noise level of independent sampling at 1 spp.
                 let n = s.len() as f64;
                 white = s.iter().sum::<f64>() / n;
@@ -266,7 +326,13 @@ pub fn run(output: &Path, width: u32, height: u32) -> Result<(), String> {
             img.iter_mut().for_each(|v| *v /= white.max(1e-300));
         }
     }
-    let fig = SamplerFigure { points, spectra, spectrum_range: (-2.5, 0.5) };
+    let fig = SamplerFigure {
+        points,
+        spectra,
+        spectrum_spp: options.spectrum_spp.clone(),
+        spectrum_range: (-2.5, 0.5),
+        points_title: options.points,
+    };
     if ext == "svg" {
         plot::save_svg(output, (width, height), &fig)
     } else {

@@ -508,3 +508,33 @@ fn numeric_flags_are_validated_like_their_toml_twins() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }
+
+// ---------------------------------------------------------------------------------------------------------
+// A signal during start-up (before any sample): nothing to write, and it says so (exit 130, no file)
+
+#[test]
+fn a_signal_during_start_up_writes_nothing_and_says_so() {
+    let dir = std::env::temp_dir().join(format!("mislab-startup-signal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("x.png");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_mislab"));
+    // Path tracing of the Cornell box: its start-up (device, BVH, shader compilation) takes seconds on lavapipe.
+    cmd.args(["render", "cornell-box", "--mode", "path", "--spp", "100000", "--width", "64", "--height", "64", "-o"])
+        .arg(&out)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    let child = cmd.spawn().unwrap();
+    // After the handler is installed (right after the flags are parsed), before the first sample.
+    std::thread::sleep(Duration::from_millis(300));
+    // SAFETY: kill(2) on our own child's pid.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let start = Instant::now();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    println!("exit {:?} {:.1} s after SIGTERM:\n{err}", o.status.code(), start.elapsed().as_secs_f64());
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted during start-up") && err.contains("no image was written"), "{err}");
+    assert!(!out.exists(), "a signal before any sample must not leave an (empty) image");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -651,6 +651,34 @@ fn sampler_figure_and_spectra() {
     assert!(run(&dir.join("samplers.jpg"), 1500, 1000).is_err());
 }
 
+/// `mislab figure samplers` follows --spp and --seed (a different figure for each) and says what it wrote.
+#[test]
+fn figure_samplers_follows_spp_and_seed_and_reports() {
+    let dir = scratch("figure-cli");
+    let figure = |spp: &str, seed: &str, name: &str| {
+        let out = dir.join(name);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mislab"))
+            .args(["figure", "samplers", "--width", "40", "--height", "50", "--spp", spp, "--seed", seed, "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        (o.status.code(), err, out)
+    };
+    let (code, err, a) = figure("16", "0", "a.png");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("wrote") && err.contains("16 points per sampler") && err.contains("seed 0"), "{err}");
+    let (_, _, b) = figure("16", "3", "b.png");
+    let (_, _, c) = figure("4", "0", "c.png");
+    let img = |p: &std::path::Path| image::open(p).unwrap().into_rgb8();
+    assert_eq!(img(&a).dimensions(), (240, 200));
+    assert_ne!(img(&a), img(&b), "--seed must change the figure");
+    assert_ne!(img(&a), img(&c), "--spp must change the figure");
+    let (code, err, _) = figure("5000", "0", "d.png");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("1 to 1024"), "{err}");
+}
+
 /// A reference's EXR header records its sample count and settings, and the pixels survive the round trip.
 #[test]
 fn reference_exr_records_spp_and_settings() {
@@ -754,6 +782,27 @@ fn bench_end_to_end_from_flags() {
         assert!(dir.join(f).exists(), "{f} missing");
     }
     assert!(std::fs::read_dir(dir.join("refs")).unwrap().count() == 1, "the reference is cached");
+    // Every row counts its NaN/Inf samples; the reference's spp is the real one.
+    assert!(rows.iter().all(|r| r[col("nonfinite_samples")] == "0"), "NaN/Inf counts per row");
+    assert_eq!(json["groups"][0]["reference_spp"], 256);
+    assert_eq!(json["groups"][0]["group"]["reference_spp"], 256);
+    assert!(std::fs::read_to_string(dir.join("summary.md")).unwrap().contains("(256 spp)"));
+    // A given reference: its header's spp is reported, whatever --ref-spp says; an 8-bit PNG is refused.
+    let cached = std::fs::read_dir(dir.join("refs")).unwrap().next().unwrap().unwrap().path();
+    let again = dir.join("again").to_string_lossy().into_owned();
+    let with_ref = |r: &std::path::Path, out: &str| {
+        let r = r.to_string_lossy().into_owned();
+        let args = ["bench", "veach-mis", "--width", "24", "--height", "16", "--spp", "2", "--seeds", "1"];
+        BenchCli::parse_from(args.into_iter().chain(["--ref", &r, "--ref-spp", "4096", "--out", out]))
+    };
+    mislab::bench::run(&with_ref(&cached, &again).args).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("again/results.json")).unwrap()).unwrap();
+    assert_eq!(json["groups"][0]["reference_spp"], 256, "the given file's spp, not --ref-spp");
+    let png = dir.join("ref.png");
+    image::RgbImage::new(24, 16).save(&png).unwrap();
+    let e = mislab::bench::run(&with_ref(&png, &again).args).unwrap_err();
+    assert!(e.contains("not an OpenEXR file"), "{e}");
 }
 
 /// A TOML configuration with two groups, one reading the reference the other wrote.

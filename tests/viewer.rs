@@ -154,7 +154,7 @@ fn exposure_and_view_do_not_restart_but_compare_renders_both_sides() {
     let (mut h, _one) = harness(args());
     step_until(&mut h, "the first full pass", |s| s.stats[0].spp >= 1);
     let generation = h.state().engine().shared().stats[0].generation;
-    select(&mut h, "view", 0, "stderr");
+    select(&mut h, "view", 0, "std-error");
     assert_eq!(h.state().display.view, View::StdErr);
     // The false-colour legend appears with the error views.
     assert!(h.query_by_label_contains("standard error of the pixel mean").is_some(), "the legend is shown");

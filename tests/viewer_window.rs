@@ -43,8 +43,10 @@ fn screenshot_of_a_real_window_with_toggles() {
             "bsdf",
             "--toggles",
             "2",
+            // Few frames: the first frames are bands of the first pass, and the screenshot must still wait for a
+            // whole sample per pixel (it once captured "0 spp").
             "--frames",
-            "10",
+            "2",
             "--screenshot",
         ])
         .arg(&shot)
@@ -55,6 +57,11 @@ fn screenshot_of_a_real_window_with_toggles() {
     assert!(out.status.success(), "mislab view failed ({}):\n{stderr}", out.status);
     assert!(stderr.contains("UI while rendering"), "it reports the UI frame rate:\n{stderr}");
     assert!(stderr.contains("first image of the new estimator"), "it reports the toggle latency:\n{stderr}");
+    let spp: u32 = stderr
+        .lines()
+        .find_map(|l| l.split_once(" (")?.1.strip_suffix(" spp on side A)")?.parse().ok())
+        .unwrap_or_else(|| panic!("it says how many spp the screenshot shows:\n{stderr}"));
+    assert!(spp >= 1, "the screenshot shows {spp} spp:\n{stderr}");
     let img = image::open(&shot).expect("the screenshot was written").to_rgb8();
     let panel = mislab::viewer::app::PANEL_WIDTH as u32;
     assert!(

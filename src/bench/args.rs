@@ -7,11 +7,13 @@ use super::*;
 pub struct BenchArgs {
     #[command(flatten)]
     pub scene: SceneSpec,
-    /// Reference image (EXR, e.g. from `mislab reference`); without one, a reference is rendered (MIS + Sobol,
+    /// Reference image (linear EXR, e.g. from `mislab reference`, or a .state; an 8-bit PNG is refused); without one, a reference is rendered (MIS + Sobol,
     /// --ref-spp samples) and cached in --out DIR/refs/.
     #[arg(long = "ref")]
     pub reference: Option<PathBuf>,
-    /// Samples per pixel of a reference rendered here.
+    /// Samples per pixel of a reference rendered here (--suite lecture renders its path-traced Cornell group's at a
+    /// quarter of this: path samples cost several times direct ones, and a quarter still leaves the reference's
+    /// variance 16× below that of the last point). Reports give each reference's real spp, from its header.
     #[arg(long, default_value_t = 4096)]
     pub ref_spp: u32,
     /// Light selection of a reference rendered here (the light tree converges fastest with many lights).

@@ -15,6 +15,7 @@ pub mod plot;
 mod results;
 mod runner;
 mod suite;
+mod ticks;
 
 pub use args::BenchArgs;
 pub use group::{BenchFile, BenchGroup};

@@ -27,7 +27,7 @@ pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult
         .collect();
     let json = serde_json::json!({
         "device": { "name": ctx.info.name, "type": format!("{:?}", ctx.info.device_type), "driver": format!("{} {}", ctx.info.driver, ctx.info.driver_info), "timestamps": ctx.timestamps },
-        "groups": results.iter().zip(&summaries).map(|(r, (_, s))| serde_json::json!({ "group": r.group, "reference": r.reference, "summary": s })).collect::<Vec<_>>(),
+        "groups": results.iter().zip(&summaries).map(|(r, (_, s))| serde_json::json!({ "group": group_json(r), "reference": r.reference, "reference_spp": r.reference_spp, "summary": s })).collect::<Vec<_>>(),
         "rows": rows,
     });
     write("results.json", &serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?)?;
@@ -37,14 +37,19 @@ pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult
         plot::error_plots(out, &base, name, sums)?;
         plot::heatmaps(out, &base, name, res.group.width, res.group.height, &res.heatmaps)?;
         md += &format!(
-            "\n## {name}\n\n{} at {}x{}, {} seed(s), reference {}.\n\n| configuration | spp | relMSE (mean over seeds) | GPU s | efficiency (of the means) | RMSE slope | M samples/s | Mrays/s | s to relMSE 1e-2 | s to 1e-3 | compile + warm-up s |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
-            res.group.scene, res.group.width, res.group.height, res.group.seeds, res.reference
+            "\n## {name}\n\n{} at {}x{}, {} seed(s), reference {} ({}).\n\n| configuration | spp | relMSE (mean over seeds) | GPU s | efficiency (of the means) | RMSE slope | M samples/s | Mrays/s | s to relMSE 1e-2 | s to 1e-3 | compile + warm-up s | NaN/Inf samples |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+            res.group.scene,
+            res.group.width,
+            res.group.height,
+            res.group.seeds,
+            res.reference,
+            res.reference_spp.map_or("its header records no spp".into(), |n| format!("{n} spp"))
         );
         for s in sums {
             let i = s.spp.len().saturating_sub(1);
             let opt = |v: Option<f64>| v.map(|x| format!("{x:.3}")).unwrap_or_else(|| "—".into());
             md += &format!(
-                "| {} | {} | {:.3e} | {:.3} | {:.3e} | {} | {:.2} | {:.2} | {} | {} | {:.2} |\n",
+                "| {} | {} | {:.3e} | {:.3} | {:.3e} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {} |\n",
                 s.config,
                 s.spp.get(i).copied().unwrap_or(0),
                 s.relmse.get(i).map(|r| r[0]).unwrap_or(f64::NAN),
@@ -55,7 +60,8 @@ pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult
                 s.mrays_per_second,
                 opt(s.seconds_to[0]),
                 opt(s.seconds_to[1]),
-                s.compile_seconds
+                s.compile_seconds,
+                s.nonfinite
             );
         }
         if let (Some(best), Some(worst)) = (
@@ -76,4 +82,12 @@ pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult
     write("summary.md", &md)?;
     eprintln!("wrote {}/results.csv, results.json, summary.md and plots", out.display());
     Ok(())
+}
+
+/// A group as JSON, with `reference_spp` the reference's real sample count (from its header; null when it
+/// records none) rather than the asked-for one, which a given `--ref` file does not follow.
+fn group_json(r: &GroupResult) -> serde_json::Value {
+    let mut v = serde_json::to_value(&r.group).unwrap_or_default();
+    v["reference_spp"] = serde_json::json!(r.reference_spp);
+    v
 }

@@ -1,7 +1,9 @@
 //! Plots (plotters): PNG through an in-memory RGB bitmap encoded by `image`, and SVG. Text uses egui's Hack
 //! font, registered with plotters' ab_glyph text backend (no system fonts needed).
 
+use super::ticks;
 use super::ConfigSummary;
+use plotters::coord::combinators::{BindKeyPoints, LogCoord, WithKeyPoints};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -81,12 +83,27 @@ pub fn colormap(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+type LogAxis = WithKeyPoints<LogCoord<f64>>;
+
+/// A log x axis with readable ticks: powers of two as integers for sample counts, else `ticks::log_ticks`.
+fn x_axis(lo: f64, hi: f64, integer: bool) -> LogAxis {
+    let (bold, light) = if integer { (ticks::spp_ticks(lo, hi), vec![]) } else { ticks::log_ticks(lo, hi) };
+    (lo..hi).log_scale().with_key_points(bold).with_light_points(light)
+}
+
+fn y_axis(lo: f64, hi: f64) -> LogAxis {
+    let (bold, light) = ticks::log_ticks(lo, hi);
+    (lo..hi).log_scale().with_key_points(bold).with_light_points(light)
+}
+
 /// Log-log lines of mean relMSE with min–max bars over seeds, against seconds or spp.
 pub struct ErrorPlot {
     /// Caption.
     pub title: String,
     /// x-axis description.
     pub x_desc: String,
+    /// Whether x is a sample count (integer ticks at powers of two).
+    pub integer_x: bool,
     /// Per configuration: label and points (x, mean, min, max).
     pub series: Vec<(String, Vec<(f64, f64, f64, f64)>)>,
 }
@@ -111,14 +128,14 @@ impl Figure for ErrorPlot {
             .margin(14)
             .x_label_area_size(42)
             .y_label_area_size(72)
-            .build_cartesian_2d((x0 / 1.3..x1 * 1.3).log_scale(), (y0 / 1.5..y1 * 1.5).log_scale())
+            .build_cartesian_2d(x_axis(x0 / 1.3, x1 * 1.3, self.integer_x), y_axis(y0 / 1.5, y1 * 1.5))
             .map_err(err)?;
         chart
             .configure_mesh()
             .x_desc(self.x_desc.as_str())
             .y_desc("relMSE")
-            .x_label_formatter(&|v| format!("{v:.3}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .x_label_formatter(&|v| ticks::label(*v))
+            .y_label_formatter(&|v| ticks::label(*v))
             .draw()
             .map_err(err)?;
         for (i, (label, p)) in self.series.iter().enumerate() {
@@ -171,13 +188,13 @@ pub fn error_plots(dir: &Path, base: &str, title: &str, sums: &[ConfigSummary]) 
         dir,
         &format!("{base}-error-vs-time"),
         (900, 600),
-        &ErrorPlot { title: title.into(), x_desc: "GPU seconds".into(), series: series(true) },
+        &ErrorPlot { title: title.into(), x_desc: "GPU seconds".into(), integer_x: false, series: series(true) },
     )?;
     save(
         dir,
         &format!("{base}-error-vs-spp"),
         (900, 600),
-        &ErrorPlot { title: title.into(), x_desc: "samples per pixel".into(), series: series(false) },
+        &ErrorPlot { title: title.into(), x_desc: "samples per pixel".into(), integer_x: true, series: series(false) },
     )
 }
 
@@ -240,11 +257,20 @@ impl Figure for Heatmaps {
             ))
             .map_err(err)?;
         }
-        let fmt = |v: f64| if self.log { format!("1e{v:.1}") } else { format!("{v:.3}") };
+        // Ends as values (not "1e0.6"), and each whole decade between them marked under the bar.
+        let fmt = |v: f64| if self.log { ticks::label_log10(v) } else { format!("{v:.3}") };
         bar.draw(&Text::new(fmt(self.range.0), (bx as i32 - 60, 14), ("sans-serif", 13))).map_err(err)?;
         bar.draw(&Text::new(fmt(self.range.1), ((bx + steps as f64 * bw) as i32 + 8, 14), ("sans-serif", 13)))
             .map_err(err)?;
-        bar.draw(&Text::new(self.legend.clone(), (bx as i32, 38), ("sans-serif", 13))).map_err(err)?;
+        let span = (self.range.1 - self.range.0).max(1e-30);
+        if self.log {
+            for d in (self.range.0.ceil() as i32)..=(self.range.1.floor() as i32) {
+                let x = (bx + (d as f64 - self.range.0) / span * steps as f64 * bw) as i32;
+                bar.draw(&PathElement::new(vec![(x, 30), (x, 35)], BLACK)).map_err(err)?;
+                bar.draw(&Text::new(ticks::label(10f64.powi(d)), (x - 12, 34), ("sans-serif", 12))).map_err(err)?;
+            }
+        }
+        bar.draw(&Text::new(self.legend.clone(), (bx as i32, 50), ("sans-serif", 13))).map_err(err)?;
         Ok(())
     }
 }

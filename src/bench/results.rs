@@ -70,6 +70,8 @@ pub struct BenchRow {
     pub warmup_seconds: f64,
     /// Samples per pixel in one dispatch.
     pub dispatch_spp: u32,
+    /// NaN/Inf samples in this seed's image at this spp (counted on the device; they are left out of the mean).
+    pub nonfinite: u64,
 }
 
 /// CSV columns, in order.
@@ -103,6 +105,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "compile_seconds",
     "warmup_seconds",
     "dispatch_spp",
+    "nonfinite_samples",
 ];
 
 fn csv_field(s: &str) -> String {
@@ -147,6 +150,7 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             format!("{:.3}", r.compile_seconds),
             format!("{:.3}", r.warmup_seconds),
             r.dispatch_spp.to_string(),
+            r.nonfinite.to_string(),
         ];
         out += &f.join(",");
         out += "\n";
@@ -179,6 +183,8 @@ pub struct ConfigSummary {
     pub seconds_to: [Option<f64>; 2],
     /// Compilation and warm-up seconds.
     pub compile_seconds: f64,
+    /// NaN/Inf samples at the last point, summed over seeds.
+    pub nonfinite: u64,
 }
 
 pub(super) fn summarize(rows: &[&BenchRow]) -> ConfigSummary {
@@ -199,6 +205,7 @@ pub(super) fn summarize(rows: &[&BenchRow]) -> ConfigSummary {
         mrays_per_second: mean(&rows.iter().map(|r| r.mrays_per_second).collect::<Vec<_>>()),
         seconds_to: [None, None],
         compile_seconds: rows.iter().map(|r| r.compile_seconds + r.warmup_seconds).fold(0.0, f64::max),
+        nonfinite: by_spp.values().last().map_or(0, |rs| rs.iter().map(|r| r.nonfinite).sum()),
     };
     for (spp, rs) in &by_spp {
         let rel: Vec<f64> = rs.iter().map(|r| r.relmse).collect();

@@ -12,6 +12,8 @@ pub(super) struct GroupResult {
     /// Per configuration label: mean per-pixel relMSE over seeds at the last point.
     pub(super) heatmaps: Vec<(String, Vec<f64>)>,
     pub(super) reference: String,
+    /// The reference's real sample count, from its header (None for an EXR from elsewhere, which records none).
+    pub(super) reference_spp: Option<u32>,
 }
 
 pub(super) fn slug(s: &str) -> String {
@@ -32,7 +34,9 @@ fn group_reference(
     g: &BenchGroup,
     scene: &crate::scene::Scene,
     refs: &Path,
-) -> Result<(Vec<[f32; 3]>, String), String> {
+) -> Result<(Vec<[f32; 3]>, String, Option<u32>), String> {
+    // What the header says, not what was asked: a given file's spp is its own.
+    let header_spp = |r: &reference::ReferenceImage| r.attributes.get("spp").and_then(|s| s.parse().ok());
     if let Some(path) = &g.reference {
         let r = reference::read_exr(path)?;
         if (r.width, r.height) != (g.width, g.height) {
@@ -45,7 +49,8 @@ fn group_reference(
                 g.height
             ));
         }
-        return Ok((r.pixels, path.display().to_string()));
+        let spp = header_spp(&r);
+        return Ok((r.pixels, path.display().to_string(), spp));
     }
     let settings = reference::reference_settings(&Settings {
         width: g.width,
@@ -79,7 +84,8 @@ fn group_reference(
                 && r.attributes.get("spp").map(|s| s.as_str()) == Some(g.reference_spp.to_string().as_str())
             {
                 eprintln!("reference: reusing {}", path.display());
-                return Ok((r.pixels, path.display().to_string()));
+                let spp = header_spp(&r);
+                return Ok((r.pixels, path.display().to_string(), spp));
             }
         }
     }
@@ -95,7 +101,7 @@ fn group_reference(
     )?;
     eprintln!("reference: {} spp in {:.1} s", stats.spp, t.elapsed().as_secs_f64());
     reference::write_exr(&path, &film, &reference::header_attributes(&g.scene_spec(), &settings, &stats))?;
-    Ok((film.mean, path.display().to_string()))
+    Ok((film.mean, path.display().to_string(), Some(stats.spp)))
 }
 
 pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResult, String> {
@@ -109,7 +115,7 @@ pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result
         }
         _ => g,
     };
-    let (reference, ref_name) = group_reference(ctx, g, &scene, refs)?;
+    let (reference, ref_name, reference_spp) = group_reference(ctx, g, &scene, refs)?;
     let configs = g.configurations();
     let data = SceneData::build(&scene);
     let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", g.scene))?;
@@ -189,6 +195,7 @@ pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result
                     compile_seconds: if seed == 0 { compile_seconds } else { 0.0 },
                     warmup_seconds: if seed == 0 { warmup_seconds } else { 0.0 },
                     dispatch_spp,
+                    nonfinite: point.nonfinite,
                 });
                 if let Some(h) = heat {
                     match &mut sum_heat {
@@ -198,26 +205,32 @@ pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result
                 }
             }
         }
-        let last = rows.last().expect("a row");
+        // The mean over seeds at the last point, as summary.md reports it (not the last seed's).
+        let s = summarize(&rows.iter().filter(|r| r.config == label).collect::<Vec<_>>());
+        let i = s.spp.len() - 1;
         eprintln!(
-            "  {label}: {} spp: relMSE {:.3e}, {:.3} s GPU, {:.2} M samples/s",
-            last.spp,
-            last.relmse,
-            last.seconds_gpu,
-            last.samples_per_second / 1e6
+            "  {label}: {} spp: relMSE {:.3e} (mean of {} seeds), {:.3} s GPU, {:.2} M samples/s, {} NaN/Inf samples",
+            s.spp[i],
+            s.relmse[i][0],
+            g.seeds,
+            s.seconds[i],
+            s.samples_per_second / 1e6,
+            s.nonfinite
         );
         if let Some(mut h) = sum_heat {
             h.iter_mut().for_each(|v| *v /= g.seeds as f64);
             heatmaps.push((label, h));
         }
     }
-    Ok(GroupResult { group: g.clone(), rows, heatmaps, reference: ref_name })
+    Ok(GroupResult { group: g.clone(), rows, heatmaps, reference: ref_name, reference_spp })
 }
 
 struct Point {
     spp: u32,
     timing: Timing,
     metrics: ErrorMetrics,
+    /// NaN/Inf samples in the image at this point (counted on the device).
+    nonfinite: u64,
 }
 
 enum SeedError {
@@ -288,7 +301,7 @@ fn run_seed(
             None => k + 1 == ladder.len(),
         };
         let heat = if last { Some(metrics::per_pixel_relmse(&film.mean, reference)?) } else { None };
-        points.push((Point { spp, timing, metrics: m }, heat));
+        points.push((Point { spp, timing, metrics: m, nonfinite: film.nonfinite_total }, heat));
         if last {
             break;
         }

@@ -1,6 +1,7 @@
 //! PLY meshes (ASCII, binary little- and big-endian; gzip'd `.ply.gz`): vertex positions, normals and UVs, and
 //! polygon faces fanned into triangles. Elements and properties we do not use are read past.
 
+use crate::input_file::clip;
 use glam::{Vec2, Vec3};
 
 /// A PLY mesh in its own (object) space.
@@ -85,7 +86,7 @@ impl Reader<'_> {
     fn value(&mut self, ty: Scalar) -> Result<f64, String> {
         if self.format == Format::Ascii {
             let w = self.words.next().ok_or("the file ends before all elements are read (truncated?)")?;
-            return w.parse::<f64>().map_err(|_| format!("'{w}' is not a number"));
+            return w.parse::<f64>().map_err(|_| format!("'{}' is not a number", clip(w, 40)));
         }
         let n = ty.size();
         let b =
@@ -138,26 +139,27 @@ pub fn decode(bytes: &[u8]) -> Result<PlyMesh, String> {
                     "ascii" => Format::Ascii,
                     "binary_little_endian" => Format::Little,
                     "binary_big_endian" => Format::Big,
-                    _ => return Err(format!("header line {hl}: unknown format '{f}'")),
+                    _ => return Err(format!("header line {hl}: unknown format '{}'", clip(f, 40))),
                 })
             }
             ["element", name, count] => {
-                let count = count.parse().map_err(|_| format!("header line {hl}: bad element count '{count}'"))?;
+                let count =
+                    count.parse().map_err(|_| format!("header line {hl}: bad element count '{}'", clip(count, 40)))?;
                 elements.push(Element { name: name.to_string(), count, props: vec![] });
             }
             ["property", "list", c, t, name] => {
                 let (Some(c), Some(t)) = (Scalar::parse(c), Scalar::parse(t)) else {
-                    return Err(format!("header line {hl}: unknown list types in '{line}'"));
+                    return Err(format!("header line {hl}: unknown list types in '{}'", clip(line, 80)));
                 };
                 let e = elements.last_mut().ok_or(format!("header line {hl}: property before any element"))?;
                 e.props.push(Property { name: name.to_string(), list: Some(c), ty: t });
             }
             ["property", t, name] => {
-                let t = Scalar::parse(t).ok_or(format!("header line {hl}: unknown property type '{t}'"))?;
+                let t = Scalar::parse(t).ok_or(format!("header line {hl}: unknown property type '{}'", clip(t, 40)))?;
                 let e = elements.last_mut().ok_or(format!("header line {hl}: property before any element"))?;
                 e.props.push(Property { name: name.to_string(), list: None, ty: t });
             }
-            _ => return Err(format!("header line {hl}: cannot read '{line}'")),
+            _ => return Err(format!("header line {hl}: cannot read '{}'", clip(line, 80))),
         }
     }
     let format = format.ok_or("PLY header has no 'format' line")?;
@@ -169,7 +171,11 @@ pub fn decode(bytes: &[u8]) -> Result<PlyMesh, String> {
     for e in &elements {
         // Bound the allocation by what the file can hold (each element is at least one byte or word).
         if e.count > bytes.len() {
-            return Err(format!("element '{}' claims {} entries, more than the file can hold", e.name, e.count));
+            return Err(format!(
+                "element '{}' claims {} entries, more than the file can hold",
+                clip(&e.name, 40),
+                e.count
+            ));
         }
         let idx = |n: &[&str]| e.props.iter().position(|p| n.contains(&p.name.as_str()));
         let (px, py, pz) = (idx(&["x"]), idx(&["y"]), idx(&["z"]));
@@ -188,7 +194,7 @@ pub fn decode(bytes: &[u8]) -> Result<PlyMesh, String> {
                 if let Some(ct) = p.list {
                     let n = r.value(ct)?;
                     if !(0.0..=1024.0).contains(&n) || n.fract() != 0.0 {
-                        return Err(format!("element '{}': list length {n} is out of range", e.name));
+                        return Err(format!("element '{}': list length {n} is out of range", clip(&e.name, 40)));
                     }
                     list.clear();
                     for _ in 0..n as usize {
@@ -229,7 +235,7 @@ pub fn decode(bytes: &[u8]) -> Result<PlyMesh, String> {
 /// Triangulates a polygon as a fan from its first vertex.
 fn fan(list: &[f64], out: &mut Vec<[u32; 3]>) -> Result<(), String> {
     if list.iter().any(|&i| i < 0.0 || i > u32::MAX as f64 || i.fract() != 0.0) {
-        return Err(format!("face has an invalid vertex index in {list:?}"));
+        return Err(format!("face has an invalid vertex index in {}", clip(&format!("{list:?}"), 80)));
     }
     for k in 2..list.len() {
         out.push([list[0] as u32, list[k - 1] as u32, list[k] as u32]);

@@ -23,6 +23,10 @@ pub enum Check {
     Finite,
     /// Image mean (all pixels and channels) equal to `expected` within `rel_tol` relative plus 5 standard errors.
     Mean { expected: f64, rel_tol: f64 },
+    /// A z-test: the image mean equal to its exact expectation (the mean over the pixels' footprints) within 5
+    /// standard errors, plus `floor` relative for f32 arithmetic (`F32_FLOOR` unless a case says why it needs
+    /// more) — no percent-level tolerance that could hide a bias.
+    Exact { expected: f64, floor: f64 },
     /// Image mean equal to that of the case named `twin` (run earlier) within `rel_tol` plus 5 standard errors.
     SameAs { twin: String, rel_tol: f64 },
     /// Every pixel exactly 0.
@@ -197,6 +201,15 @@ fn judge(c: &Case, film: &Film, nonfinite: u64, seconds: f64, means: &HashMap<St
             }
         }
         Check::Mean { expected, rel_tol } => compare(&mut o, *expected, *rel_tol, 0.0),
+        Check::Exact { expected, floor } => {
+            compare(&mut o, *expected, *floor, 0.0);
+            // Deterministic samples (a directional light on Lambert) have no variance: no z to report.
+            if se > 0.0 {
+                o.detail = format!("{}, z = {:.1}", o.detail, (mean - expected) / se);
+            } else {
+                o.detail = format!("{}, no sample variance", o.detail);
+            }
+        }
         Check::SameAs { twin, rel_tol } => match means.get(twin) {
             Some(&(m, s)) => compare(&mut o, m, *rel_tol, s),
             None => fail(&mut o, format!("its twin '{twin}' did not run")),
@@ -221,6 +234,10 @@ fn judge(c: &Case, film: &Film, nonfinite: u64, seconds: f64, means: &HashMap<St
     }
     o
 }
+
+/// Relative allowance of `Check::Exact` for f32 rendering (a few hundred ulps through camera, BSDF and light
+/// arithmetic); where the samples barely vary (a tiny light's cone) the standard error alone would be below it.
+pub const F32_FLOOR: f64 = 2e-5;
 
 /// One line per outcome, as `mislab stress` and the test print them while the suite runs.
 pub fn progress_line(o: &Outcome) -> String {

@@ -37,7 +37,8 @@ impl View {
     pub fn name(self) -> &'static str {
         match self {
             View::Image => "image",
-            View::StdErr => "stderr",
+            // Not "stderr": that reads as the error stream.
+            View::StdErr => "std-error",
             View::RelMse => "relmse",
             View::NonFinite => "nan-inf",
         }

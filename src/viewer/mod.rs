@@ -40,7 +40,8 @@ pub struct ViewArgs {
     /// Start with a split-screen comparison whose side B uses this strategy.
     #[arg(long, value_enum)]
     pub compare: Option<Strategy>,
-    /// What is shown: image, stderr, relmse or nan-inf.
+    /// What is shown: image, std-error (the standard error of each pixel's mean, false colour), relmse (against
+    /// --reference) or nan-inf.
     #[arg(long, default_value = "image", value_parser = parse_view)]
     pub view: View,
     /// Tonemapper.
@@ -53,7 +54,7 @@ pub struct ViewArgs {
     /// frames, then exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
-    /// Render frames (bounded-time dispatches) before the screenshot.
+    /// Render frames (bounded-time dispatches) before the screenshot; it also waits for a whole sample per pixel.
     #[arg(long, default_value_t = 30)]
     pub frames: u64,
     /// With --screenshot: first toggle side A's strategy this many times (cycling through every
@@ -70,6 +71,8 @@ pub struct ViewArgs {
 }
 
 fn parse_view(s: &str) -> Result<View, String> {
+    // The old name, kept working for scripts.
+    let s = if s == "stderr" { "std-error" } else { s };
     View::ALL.iter().copied().find(|v| v.name() == s).ok_or_else(|| {
         format!(
             "unknown view '{s}' (expected one of: {})",
@@ -148,6 +151,8 @@ struct Screenshot {
     requested: bool,
     saved: Arc<Mutex<Option<Result<(), String>>>>,
     rendering_since: Option<Instant>,
+    /// The frame count when every rendered side first had a whole sample per pixel (after the toggles).
+    sampled_at: Option<u64>,
 }
 
 /// How the window ended.
@@ -173,9 +178,13 @@ impl App {
     fn screenshot_step(&mut self, ctx: &egui::Context) {
         let Some(shot) = &mut self.shot else { return };
         ctx.request_repaint();
-        let (frames, fatal, compiling) = {
+        let (frames, fatal, compiling, sampled) = {
             let s = self.viewer.engine().shared();
-            (s.frames, s.fatal.clone(), s.compiling)
+            // Every rendered side has a whole sample per pixel: frames are time-bounded bands, so at 512² the
+            // first frames are all parts of the first pass (the window said "0 spp").
+            let sides = if s.compare { 2 } else { 1 };
+            let sampled = s.stats.iter().take(sides).all(|st| st.spp >= 1 && st.shown);
+            (s.frames, s.fatal.clone(), s.compiling, sampled)
         };
         if let Some(f) = fatal {
             return self.finish(ctx, Err(f));
@@ -216,7 +225,12 @@ impl App {
         }
         let base = *shot.frames_at_toggles_end.get_or_insert(frames);
         let shown = self.viewer.frame().map(|f| f.serial).unwrap_or(0);
-        if !shot.requested && frames >= base + shot.frames && shown >= base + shot.frames {
+        if sampled && shot.sampled_at.is_none() {
+            shot.sampled_at = Some(frames);
+        }
+        // A frame finished after the first whole pass shows it.
+        let shows_samples = shot.sampled_at.is_some_and(|f| shown > f);
+        if !shot.requested && frames >= base + shot.frames && shown >= base + shot.frames && shows_samples {
             shot.requested = true;
             let path = shot.path.clone();
             let saved = shot.saved.clone();
@@ -240,7 +254,8 @@ impl App {
             self.report();
             let path = self.shot.as_ref().map(|s| s.path.display().to_string()).unwrap_or_default();
             if r.is_ok() {
-                eprintln!("wrote {path}");
+                let spp = self.viewer.engine().shared().stats[0].spp;
+                eprintln!("wrote {path} ({spp} spp on side A)");
             }
             self.finish(ctx, r);
         }
@@ -371,6 +386,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
                 requested: false,
                 saved: Arc::new(Mutex::new(None)),
                 rendering_since: None,
+                sampled_at: None,
             });
             Ok(Box::new(App { viewer, ui_cpu: Vec::new(), shot, outcome: outcome2 }))
         }),
