@@ -8,9 +8,9 @@ mod common;
 
 use common::env_or;
 use mislab::features::Features;
-use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::render::Renderer;
 use mislab::settings::{Mode, Settings};
+use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::time::Instant;
 
 fn main() {

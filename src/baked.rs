@@ -14,8 +14,8 @@
 //! viewer's) never calls the baked function.
 
 use crate::convex_solids::convex_solids;
-use crate::gpu_scene::SceneData;
 use crate::gpu_types::*;
+use crate::scene_data::SceneData;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::fmt::Write;

@@ -4,9 +4,9 @@
 //! tests/layout.rs checks them against what naga reads in the composed module.
 
 use crate::bvh::GpuBvhNode;
-use crate::gpu_scene::SceneData;
 use crate::gpu_types::*;
 use crate::light_tree::GpuLightNode;
+use crate::scene_data::SceneData;
 
 /// How a shader reaches a binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,8 +1,8 @@
 //! Features: what a scene uses, derived from its flattened data, and the pipeline constants that compile
 //! out everything else. `Settings` decide which techniques run; `Features` decide which code exists.
 
-use crate::gpu_scene::SceneData;
 use crate::gpu_types::*;
+use crate::scene_data::SceneData;
 use crate::settings::Settings;
 
 /// What kind of environment the scene has.

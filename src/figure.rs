@@ -13,10 +13,10 @@
 
 use crate::film::{Film, Tonemap};
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, SceneData};
 use crate::render::Renderer;
 use crate::scene::{self, LoadOptions};
 use crate::settings::{Heuristic, LightSampling, LightSelect, Settings, Strategy};
+use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::path::PathBuf;
 
 /// `mislab figure WHICH -o OUT.png`: one of the lecture's figures as a labelled PNG.

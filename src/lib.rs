@@ -34,6 +34,7 @@ pub mod render_error;
 pub mod sampler_figure;
 pub mod samplers;
 pub mod scene;
+pub mod scene_data;
 pub mod settings;
 pub mod shaders;
 pub mod state;

@@ -3,11 +3,11 @@
 use clap::{Args, Parser, Subcommand};
 use mislab::film::Tonemap;
 use mislab::gpu::{self, GpuContext};
-use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::progressive::{self, Budget};
 use mislab::render::Renderer;
 use mislab::scene::{self, Environment, SceneSpec};
 use mislab::settings::*;
+use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};

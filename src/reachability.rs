@@ -2,9 +2,9 @@
 //! are found only by light sampling, and light seen through smooth glass or in a mirror (delta BSDF lobes) or
 //! through a closed dielectric only by direction (BSDF) samples.
 
-use crate::gpu_scene::SceneData;
 use crate::gpu_types::{GpuMaterial, MATERIAL_CONDUCTOR, MATERIAL_DIELECTRIC};
 use crate::scene::DELTA_ALPHA;
+use crate::scene_data::SceneData;
 use crate::settings::{Settings, Strategy};
 
 /// Whether the material's BSDF is delta-only (an exact mirror or a smooth dielectric, as the shaders decide).

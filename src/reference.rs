@@ -5,12 +5,12 @@
 pub use crate::exr_image::ReferenceImage;
 use crate::film::Film;
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, SceneData};
 use crate::gpu_timer::GpuTimer;
 use crate::progressive::{Budget, RenderStats};
 use crate::render::Renderer;
 use crate::scene::{Scene, SceneSpec};
 use crate::settings::*;
+use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

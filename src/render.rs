@@ -49,7 +49,7 @@ pub fn render_source() -> String {
 
 /// The render module for one scene: with its data baked in when it is small enough (`Features::flat`), else
 /// `render_source()`.
-pub fn render_source_for(data: &crate::gpu_scene::SceneData) -> String {
+pub fn render_source_for(data: &crate::scene_data::SceneData) -> String {
     match crate::baked::scene_data_source(data) {
         Some((data, geometry)) => {
             shaders::compose_replacing(RENDER_FILES, &[("scene_data.wgsl", &data), ("baked_geometry.wgsl", &geometry)])

@@ -7,8 +7,8 @@
 mod common;
 
 use mislab::features::Features;
-use mislab::gpu_scene::SceneData;
 use mislab::scene::{self, LoadOptions, Scene};
+use mislab::scene_data::SceneData;
 use mislab::settings::{Mode, Settings, Strategy};
 use std::f64::consts::PI;
 use std::path::PathBuf;

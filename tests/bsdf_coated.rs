@@ -382,7 +382,7 @@ fn coated_render_has_no_nan() {
         let a = alphas[i % alphas.len()];
         m.kind = MaterialKind::CoatedDiffuse { eta: etas[i % etas.len()], alpha_u: a, alpha_v: a.max(ALPHA_MIN) * 2.0 };
     }
-    let data = mislab::gpu_scene::SceneData::build(&s);
+    let data = mislab::scene_data::SceneData::build(&s);
     let f = mislab::features::Features::of(&data);
     assert!(f.coated_diffuse && !f.conductor, "features: {}", f.describe());
     // MIS runs both the light samples (bsdf_eval, bsdf_pdf) and the BSDF samples (bsdf_sample); one pipeline.

@@ -6,8 +6,8 @@
 
 mod common;
 
-use mislab::gpu_scene::SceneData;
 use mislab::scene::{self, Environment, LoadOptions, MaterialKind};
+use mislab::scene_data::SceneData;
 use mislab::settings::{Mode, Settings, Strategy};
 
 /// A row of conductors in a white furnace (constant radiance 1, nothing else): k = 10⁴ makes F ≈ 1, so each

@@ -5,8 +5,8 @@ mod common;
 
 use glam::{DVec3, Vec3};
 use mislab::convex_solids::{convex_solids, ConvexSolid};
-use mislab::gpu_scene::SceneData;
 use mislab::gpu_types::INVALID;
+use mislab::scene_data::SceneData;
 
 /// Triangles as the flattened `[x, y, z, 0]` triples `convex_solids` reads.
 fn flatten(tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {

@@ -9,11 +9,11 @@ use common::*;
 use glam::{DVec3, Vec3};
 use mislab::film::Film;
 use mislab::gpu::GpuContext;
-use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::render::Renderer;
 use mislab::scene::builtin::{VEACH_LIGHTS, VEACH_PLATES};
 use mislab::scene::{Camera, Material, Quad, Scene, Sphere};
 use mislab::settings::*;
+use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::sync::{Mutex, OnceLock};
 
 /// Family-wise level of every test in this file.

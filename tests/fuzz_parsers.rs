@@ -6,7 +6,7 @@
 //! The Bitterli scenes reference 20 MB of meshes and textures each; their mutants load stand-ins (one small PLY,
 //! TGA and PFM under the same directory names) so that a mutant that stays valid is parsed to the end, fast.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn shared(rel: &str) -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/")).join(rel)

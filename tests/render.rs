@@ -108,7 +108,7 @@ fn specialised_and_generic_pipelines_agree() {
         // Russian roulette from depth 2, so the 4-vertex paths take it: baked and BVH pipelines share one path loop
         // (shaders/integrator.wgsl) and one roulette rule, so they agree sample by sample with it too.
         let settings = Settings { mode, max_depth: 4, rr_depth: 2, ..small(24, 24) };
-        let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::gpu_scene::SceneData::build(&scene)).unwrap();
+        let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::scene_data::SceneData::build(&scene)).unwrap();
         let mut r = mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), settings.clone()).unwrap();
         r.render(&ctx, 4).unwrap();
         let special = r.film(&ctx).unwrap();
@@ -133,7 +133,7 @@ fn specialised_and_generic_pipelines_agree() {
 fn large_requests_keep_every_sample() {
     let ctx = gpu();
     let scene = scene("cornell-box");
-    let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::gpu_scene::SceneData::build(&scene)).unwrap();
+    let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::scene_data::SceneData::build(&scene)).unwrap();
     let mut r =
         mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), Settings { mode: Mode::Path, ..small(8, 8) })
             .unwrap();

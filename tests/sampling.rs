@@ -10,10 +10,10 @@
 use glam::{DVec3, Vec3};
 use mislab::chi2::{self, Chi2Options, Chi2Report, Chi2Test, Equirect, PlaneWindow, Quadrature, SphereCap};
 use mislab::gpu::GpuContext;
-use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::gpu_types::*;
 use mislab::scene::{EnvMap, Environment, Material, Mesh, PunctualLight, Quad, Scene, Sphere};
 use mislab::settings::{EnvSampling, LightSampling, LightSelect};
+use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::f64::consts::PI;
 use std::sync::{Mutex, OnceLock};
 use wgpu::util::DeviceExt;

@@ -28,7 +28,7 @@ fn every_file_is_embedded_and_nonempty() {
 #[test]
 fn baked_scene_modules_validate_and_have_their_own_keys() {
     use mislab::features::Features;
-    use mislab::gpu_scene::SceneData;
+    use mislab::scene_data::SceneData;
     let mut keys = std::collections::HashSet::new();
     for name in ["veach-mis", "cornell-box", "furnace", "area-vs-cosine"] {
         let scene = mislab::scene::load(name, &Default::default()).unwrap();

@@ -5,8 +5,8 @@
 
 mod common;
 
-use mislab::gpu_scene::SceneData;
 use mislab::scene::{self, LoadOptions, Scene};
+use mislab::scene_data::SceneData;
 use mislab::settings::{LightSampling, Mode, Settings, Strategy};
 use std::f64::consts::PI;
 

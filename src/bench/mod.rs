@@ -26,7 +26,6 @@ use runner::{run_group, slug, GroupResult};
 pub use suite::lecture_suite;
 
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, SceneData};
 use crate::gpu_timer::GpuTimer;
 use crate::metrics::{self, ErrorMetrics};
 use crate::reference;
@@ -35,6 +34,7 @@ use crate::samplers;
 use crate::scene::SceneSpec;
 use crate::settings::*;
 use crate::suite_inputs::{self, SuiteInputs};
+use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -12,9 +12,9 @@ pub mod merge;
 pub mod session;
 
 use crate::film::Film;
-use crate::gpu_scene::SceneData;
 use crate::gpu_types::GpuAccum;
 use crate::scene::Camera;
+use crate::scene_data::SceneData;
 use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use std::path::Path;

@@ -9,10 +9,10 @@ pub use cases::{cases, polygon_irradiance};
 
 use crate::film::Film;
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, SceneData};
 use crate::render::Renderer;
 use crate::scene::Scene;
 use crate::settings::Settings;
+use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::collections::HashMap;
 use std::time::Instant;
 

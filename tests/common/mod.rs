@@ -3,10 +3,10 @@
 
 use mislab::film::Film;
 use mislab::gpu::GpuContext;
-use mislab::gpu_scene::{GpuScene, SceneData};
 use mislab::render::Renderer;
 use mislab::scene::{self, LoadOptions, Scene};
 use mislab::settings::Settings;
+use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 
 /// The GPU context, or a panic that says how to get one.
 pub fn gpu() -> GpuContext {

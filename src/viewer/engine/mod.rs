@@ -15,12 +15,12 @@
 use super::display::{self, DisplayPass, ImageStats};
 use crate::features::PipelineKey;
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, SceneData};
 use crate::gpu_timer::GpuTimer;
 use crate::pipeline_cache::PipelineCache;
 use crate::render::Renderer;
 use crate::scene::{Camera, Scene};
 use crate::settings::Settings;
+use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use compile_worker::{CompileJob, Wanted};
 use side::SideState;
 use std::collections::{HashMap, HashSet};

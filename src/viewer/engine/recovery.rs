@@ -5,8 +5,8 @@ use super::display::DisplayPass;
 use super::side::SideState;
 use super::Engine;
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, SceneData};
 use crate::gpu_timer::GpuTimer;
+use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
