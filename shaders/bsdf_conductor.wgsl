@@ -76,7 +76,7 @@ fn conductor_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let av = p.alpha_v;
     let g2 = 1.0 / (1.0 + aniso_ggx_lambda(wo, au, av) + aniso_ggx_lambda(wi, au, av));
     let s = aniso_ggx_d(h, au, av) * g2 / (4.0 * wo.z * wi.z);
-    return fresnel_complex3(dot(wo, h), p.eta, p.k) * s;
+    return p.base_color * fresnel_complex3(dot(wo, h), p.eta, p.k) * s;
 }
 
 /// pdf (solid angle) of conductor_sample producing wi: G1(wo)·D(h)/(4 wo.z).
@@ -98,7 +98,7 @@ fn conductor_sample(p: BsdfParams, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
         s.wi = vec3<f32>(-wo.x, -wo.y, wo.z);
         s.pdf = 1.0;
         s.delta = true;
-        s.f = fresnel_complex3(wo.z, p.eta, p.k) / wo.z;
+        s.f = p.base_color * fresnel_complex3(wo.z, p.eta, p.k) / wo.z;
         return s;
     }
     let h = aniso_ggx_sample_visible_normal(wo, p.alpha, p.alpha_v, u);

@@ -194,7 +194,10 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     let kind = material_kind(m);
     GpuMaterial {
         // Kinds that carry their own colour (tint, reflectance) put it in base_color themselves.
-        base_color: if matches!(kind.bsdf_kind, MATERIAL_DIELECTRIC | MATERIAL_DIFFUSE_TRANSMISSION) {
+        base_color: if matches!(
+            kind.bsdf_kind,
+            MATERIAL_CONDUCTOR | MATERIAL_DIELECTRIC | MATERIAL_DIFFUSE_TRANSMISSION
+        ) {
             kind.base_color
         } else {
             m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0))
@@ -227,8 +230,9 @@ fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
     let alpha = |a: f32| finite(a, 1.0).clamp(ALPHA_MIN, 1.0);
     match &m.kind {
         MaterialKind::MetallicRoughness => GpuMaterial { bsdf_kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
-        MaterialKind::Conductor { eta, k, alpha_u, alpha_v } => GpuMaterial {
+        MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint } => GpuMaterial {
             bsdf_kind: MATERIAL_CONDUCTOR,
+            base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
             eta: eta.to_array().map(|c| finite(c, 1.0).max(1e-3)),
             k: k.to_array().map(|c| finite(c, 0.0).max(0.0)),
             alpha: alpha(*alpha_u),

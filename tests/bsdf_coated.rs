@@ -170,7 +170,12 @@ fn v4(v: DVec3, w: f64) -> [f32; 4] {
 #[test]
 fn coated_eval_matches_cpu_and_is_reciprocal() {
     let ctx = common::gpu();
-    let files = ["common.wgsl", "warps.wgsl", "bsdf_conductor.wgsl", "bsdf_coated_diffuse.wgsl", "bsdf.wgsl"];
+    // The BSDF layer as the renderer composes it: every bsdf*.wgsl over common and warps.
+    let files: Vec<&str> = mislab::render::RENDER_FILES
+        .iter()
+        .copied()
+        .filter(|f| ["common.wgsl", "warps.wgsl"].contains(f) || f.starts_with("bsdf"))
+        .collect();
     let lib = mislab::shaders::compose(&files, PROBE);
     let params = [
         Params { r: DVec3::new(0.243, 0.059, 0.0008), eta: 1.5, au: 0.2, av: 0.2 },

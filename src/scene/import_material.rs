@@ -146,16 +146,11 @@ pub fn map(
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
             match (conductor_eta_k(desc), t) {
                 // RGB or named η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
-                (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => {
-                    // Mitsuba's specular_reflectance scales the Fresnel term; the conductor kind has no tint yet.
-                    if c != Vec3::ONE {
-                        warn("a complex-Fresnel conductor without its specular_reflectance tint (rendered as 1)");
-                    }
-                    Material {
-                        kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av },
-                        ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
-                    }
-                }
+                // Mitsuba's specular_reflectance scales the Fresnel term: the conductor's tint.
+                (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => Material {
+                    kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av, tint: c },
+                    ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
+                },
                 // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
                 // normal-incidence reflectance, named_spectra): the complex-Fresnel conductor of that F(0).
                 (_, None) => {
@@ -493,7 +488,7 @@ mod tests {
         assert!((m.alpha() - 0.2).abs() < 1e-5, "{}", m.alpha());
         // RGB η and k map to the complex-Fresnel conductor exactly, with no warning.
         match m.kind {
-            MaterialKind::Conductor { eta, k, alpha_u, alpha_v } => {
+            MaterialKind::Conductor { eta, k, alpha_u, alpha_v, .. } => {
                 assert_eq!((eta, k), (Vec3::splat(1.5), Vec3::ZERO));
                 assert!((alpha_u - 0.2).abs() < 1e-5 && (alpha_v - 0.2).abs() < 1e-5);
             }

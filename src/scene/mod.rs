@@ -162,6 +162,8 @@ pub enum MaterialKind {
         alpha_u: f32,
         /// GGX α along the bitangent.
         alpha_v: f32,
+        /// Factor on the Fresnel term, linear RGB (Mitsuba's `specular_reflectance`; 1 = none).
+        tint: Vec3,
     },
     /// A rough dielectric coat of relative index `eta` over a Lambertian base (pbrt-v4 `coateddiffuse`, Mitsuba
     /// `plastic`/`roughplastic`; shaders/bsdf_coated_diffuse.wgsl). The base's reflectance is the material's
@@ -217,7 +219,13 @@ impl MaterialKind {
             let r = r.clamp(0.0, 0.9999);
             2.0 * r.sqrt() / (1.0 - r).sqrt()
         };
-        MaterialKind::Conductor { eta: Vec3::ONE, k: Vec3::new(k(r.x), k(r.y), k(r.z)), alpha_u, alpha_v }
+        MaterialKind::Conductor {
+            eta: Vec3::ONE,
+            k: Vec3::new(k(r.x), k(r.y), k(r.z)),
+            alpha_u,
+            alpha_v,
+            tint: Vec3::ONE,
+        }
     }
 }
 

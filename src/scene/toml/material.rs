@@ -52,7 +52,7 @@ pub(super) fn material(
     ];
     let allowed: &[&str] = match d.kind.as_str() {
         "lambert" => &["reflectance", "emission"],
-        "conductor" => &["reflectance", "alpha", "emission", "eta", "k", "alpha_u", "alpha_v"],
+        "conductor" => &["reflectance", "alpha", "emission", "eta", "k", "alpha_u", "alpha_v", "tint"],
         "metallic-roughness" => &["base_color", "metallic", "roughness", "specular", "emission"],
         "coated-diffuse" => &["reflectance", "eta", "alpha", "alpha_u", "alpha_v", "emission"],
         "emitter" => &["emission"],
@@ -102,7 +102,7 @@ pub(super) fn material(
             }
             Material {
                 name: name.into(),
-                kind: MaterialKind::Conductor { eta, k, alpha_u, alpha_v },
+                kind: MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint: color("tint", d.tint, 1.0)? },
                 base_color: Vec3::ONE,
                 ..Default::default()
             }
