@@ -209,7 +209,11 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         },
         emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
         alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
-        specular: finite(m.specular, 1.0).clamp(0.0, 1.0),
+        specular: if kind.bsdf_kind == MATERIAL_CONDUCTOR {
+            kind.specular
+        } else {
+            finite(m.specular, 1.0).clamp(0.0, 1.0)
+        },
         base_tex: bt,
         mr_tex: mt,
         emissive_tex: et,
@@ -230,8 +234,10 @@ fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
     let alpha = |a: f32| finite(a, 1.0).clamp(ALPHA_MIN, 1.0);
     match &m.kind {
         MaterialKind::MetallicRoughness => GpuMaterial { bsdf_kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
-        MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint } => GpuMaterial {
+        MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, beckmann } => GpuMaterial {
             bsdf_kind: MATERIAL_CONDUCTOR,
+            // specular (unused by this kind): the microfacet distribution, 0 = GGX, 1 = Beckmann.
+            specular: if *beckmann { 1.0 } else { 0.0 },
             base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
             eta: eta.to_array().map(|c| finite(c, 1.0).max(1e-3)),
             k: k.to_array().map(|c| finite(c, 0.0).max(0.0)),

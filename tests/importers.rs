@@ -108,3 +108,25 @@ fn imported_render_has_no_nan() {
     assert_eq!(code, Some(0), "{err}");
     assert!(err.contains(" 0 NaN/Inf samples"), "{err}");
 }
+
+/// Mitsuba's veach-mis plates are `roughconductor`s with the default (Beckmann) distribution and
+/// `specular_reflectance` 0.3: both reach the conductor (its GGX twin, pbrt's, stays GGX and untinted).
+#[test]
+fn mitsuba_rough_conductors_keep_beckmann_and_tint() {
+    use mislab::scene::{load, LoadOptions, MaterialKind};
+    let conductors = |rel: &str| -> Vec<(glam::Vec3, bool)> {
+        let s = load(bitterli(rel).to_str().unwrap(), &LoadOptions::default()).unwrap();
+        s.materials
+            .iter()
+            .filter_map(|m| match m.kind {
+                MaterialKind::Conductor { tint, beckmann, .. } => Some((tint, beckmann)),
+                _ => None,
+            })
+            .collect()
+    };
+    let xml = conductors("veach-mis/mitsuba3/scene.xml");
+    assert_eq!(xml.len(), 4, "{xml:?}");
+    assert!(xml.iter().all(|(t, b)| *b && (*t - glam::Vec3::splat(0.3)).abs().max_element() < 1e-6), "{xml:?}");
+    let pbrt = conductors("veach-mis/pbrt-v4/scene-v4.pbrt");
+    assert!(!pbrt.is_empty() && pbrt.iter().all(|(t, b)| !*b && *t == glam::Vec3::ONE), "{pbrt:?}");
+}

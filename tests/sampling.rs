@@ -23,7 +23,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 73;
+const FAMILY: usize = 75;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -1252,6 +1252,23 @@ fn conductor_cases() -> Vec<Case> {
             Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
         );
         c.setup.job.a = [au, 0.0, 1.0, av];
+        v.push(c);
+    }
+    // Beckmann (specular = 1 selects it): h from D(h)·cosθh, so part of the lobe falls below the surface.
+    for (au, av, inc) in [(0.4f32, 0.15f32, 50.0f64), (0.3, 0.3, 80.0)] {
+        let t = deg(inc);
+        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let mut c = bsdf_case(
+            "anisotropic Beckmann conductor (D·cos)",
+            format!("α_u = {au}, α_v = {av}, θo = {inc}°"),
+            wo,
+            [1.0; 3],
+            0.0,
+            au,
+            0.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [au, 1.0, 1.0, av];
         v.push(c);
     }
     v

@@ -144,11 +144,20 @@ pub fn map(
                 warn("a conductor without its coat");
             }
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
+            // Mitsuba's roughconductor is Beckmann unless it says ggx; pbrt-v4's conductor is always GGX.
+            let beckmann = desc.kind == "roughconductor"
+                && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx");
+            let with_distribution = |kind: MaterialKind| match kind {
+                MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, .. } => {
+                    MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, beckmann }
+                }
+                other => other,
+            };
             match (conductor_eta_k(desc), t) {
                 // RGB or named η and k: the complex-Fresnel conductor exactly (MaterialKind::Conductor).
                 // Mitsuba's specular_reflectance scales the Fresnel term: the conductor's tint.
                 (Some((eta, k)), None) if desc.params.get("reflectance").is_none() => Material {
-                    kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av, tint: c },
+                    kind: MaterialKind::Conductor { eta, k, alpha_u: au, alpha_v: av, tint: c, beckmann },
                     ..Material::conductor(&desc.name, conductor_f0(desc), alpha)
                 },
                 // A reflectance colour (pbrt-v4's "reflectance" form: η = 1, k from r) or a named spectrum (its
@@ -159,13 +168,16 @@ pub fn map(
                         warn("a complex-Fresnel conductor of reflectance 0.9 (a spectrum not in the named-spectra table)");
                     }
                     Material {
-                        kind: MaterialKind::conductor_from_reflectance(f0, au, av),
+                        kind: with_distribution(MaterialKind::conductor_from_reflectance(f0, au, av)),
                         ..Material::conductor(&desc.name, f0, alpha)
                     }
                 }
                 // A textured reflectance: the Fresnel-free GGX conductor, which reads the texture.
                 (_, Some(t)) => {
                     warn("a Fresnel-free GGX conductor with its textured normal-incidence reflectance");
+                    if beckmann {
+                        warn("a Beckmann conductor rendered as GGX (its reflectance is textured)");
+                    }
                     with_texture(Material::conductor(&desc.name, conductor_f0(desc) * c, alpha), Some(t))
                 }
             }
@@ -204,6 +216,11 @@ pub fn map(
                 alpha = 0.1;
             }
             let (au, av) = alpha_uv(desc).unwrap_or((alpha, alpha));
+            if desc.kind == "roughdielectric"
+                && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx")
+            {
+                warn("a Beckmann dielectric rendered as GGX of the same α");
+            }
             if thin && au.max(av) >= super::DELTA_ALPHA {
                 warn("a smooth thin dielectric (its roughness is dropped)");
             }

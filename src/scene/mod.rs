@@ -151,8 +151,8 @@ pub enum MaterialKind {
     #[default]
     MetallicRoughness,
     /// A conductor with the complex Fresnel term of RGB `eta` + i·`k`, and an anisotropic GGX
-    /// (Trowbridge–Reitz) microsurface of α `alpha_u` along the shading frame's tangent and `alpha_v` along its
-    /// bitangent (α below `DELTA_ALPHA` is the exact mirror, a delta lobe).
+    /// (Trowbridge–Reitz) or Beckmann microsurface of α `alpha_u` along the shading frame's tangent and `alpha_v`
+    /// along its bitangent (α below `DELTA_ALPHA` is the exact mirror, a delta lobe).
     Conductor {
         /// Real part of the index of refraction, per RGB channel.
         eta: Vec3,
@@ -164,6 +164,8 @@ pub enum MaterialKind {
         alpha_v: f32,
         /// Factor on the Fresnel term, linear RGB (Mitsuba's `specular_reflectance`; 1 = none).
         tint: Vec3,
+        /// The Beckmann distribution (Mitsuba 3's default) instead of GGX.
+        beckmann: bool,
     },
     /// A rough dielectric coat of relative index `eta` over a Lambertian base (pbrt-v4 `coateddiffuse`, Mitsuba
     /// `plastic`/`roughplastic`; shaders/bsdf_coated_diffuse.wgsl). The base's reflectance is the material's
@@ -225,6 +227,7 @@ impl MaterialKind {
             alpha_u,
             alpha_v,
             tint: Vec3::ONE,
+            beckmann: false,
         }
     }
 }

@@ -102,7 +102,14 @@ pub(super) fn material(
             }
             Material {
                 name: name.into(),
-                kind: MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint: color("tint", d.tint, 1.0)? },
+                kind: MaterialKind::Conductor {
+                    eta,
+                    k,
+                    alpha_u,
+                    alpha_v,
+                    tint: color("tint", d.tint, 1.0)?,
+                    beckmann: false,
+                },
                 base_color: Vec3::ONE,
                 ..Default::default()
             }
