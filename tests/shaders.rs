@@ -101,7 +101,7 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         assert_eq!(count(&all, &format!("LIGHT_{k}")), ops.len(), "LIGHT_{k} is named outside the light dispatchers");
     }
     assert_eq!(count(&all, ".kind"), ops.len(), "something besides the dispatchers reads a light's kind");
-    // Rust: the tag is defined in gpu_types.rs, turned into table entries in gpu_scene.rs and into HAS_* flags in
+    // Rust: the tag is defined in gpu_types.rs, turned into table entries in scene_data.rs and into HAS_* flags in
     // features.rs, and named in no other file of src/.
     let mut files = Vec::new();
     let mut stack = vec![dir.join("src")];
@@ -120,7 +120,7 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         let name = f.file_name().unwrap().to_str().unwrap();
         if kinds.iter().any(|k| text.contains(&format!("LIGHT_{k}"))) {
             assert!(
-                ["gpu_types.rs", "gpu_scene.rs", "features.rs"].contains(&name),
+                ["gpu_types.rs", "scene_data.rs", "features.rs"].contains(&name),
                 "{} names a light kind: adding one would have to touch it too",
                 f.display()
             );

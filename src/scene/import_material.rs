@@ -563,7 +563,7 @@ mod tests {
         // Mitsuba: int_ior / ext_ior by name or number; roughdielectric defaults to α = 0.1; thin is smooth.
         let d = desc("dielectric", vec![("int_ior", MatParam::Str("water".into())), ("ext_ior", MatParam::Float(1.0))]);
         assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { eta, .. } if eta == 1.333));
-        let d = desc("roughdielectric", vec![]);
+        let d = desc("roughdielectric", vec![("distribution", MatParam::Str("ggx".into()))]);
         assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
             MaterialKind::Dielectric { alpha_u, thin: false, .. } if alpha_u == 0.1));
         let d = desc("thindielectric", vec![]);
