@@ -70,9 +70,9 @@ const NAMED_IORS: &[(&str, f32)] = &[
     ("glass-F10", 1.6137),
     ("glass-F11", 1.621),
     ("vacuum", 1.0),
-    ("helium", 1.00004),
-    ("hydrogen", 1.00013),
-    ("air", 1.00028),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
     ("carbon dioxide", 1.00045),
     ("water", 1.3330),
     ("acetone", 1.36),
@@ -331,38 +331,13 @@ fn coated_diffuse(
     Ok(Mapped::Material(Box::new(with_texture(m, t))))
 }
 
-/// A Mitsuba index of refraction: a number, or one of the names of Mitsuba's IOR table (its common entries).
+/// A Mitsuba index of refraction: a number, or one of the names of `NAMED_IORS` (Mitsuba's IOR table).
 fn mitsuba_ior(desc: &MaterialDesc, name: &str, default: f32, warn: &mut impl FnMut(&str)) -> f32 {
-    const NAMED: &[(&str, f32)] = &[
-        ("vacuum", 1.0),
-        ("helium", 1.000036),
-        ("hydrogen", 1.000132),
-        ("air", 1.000277),
-        ("carbon dioxide", 1.00045),
-        ("water", 1.3330),
-        ("acetone", 1.36),
-        ("ethanol", 1.361),
-        ("carbon tetrachloride", 1.461),
-        ("glycerol", 1.4729),
-        ("benzene", 1.501),
-        ("silicone oil", 1.52045),
-        ("bromine", 1.661),
-        ("water ice", 1.31),
-        ("fused quartz", 1.458),
-        ("pyrex", 1.470),
-        ("acrylic glass", 1.49),
-        ("polypropylene", 1.49),
-        ("bk7", 1.5046),
-        ("sodium chloride", 1.544),
-        ("amber", 1.55),
-        ("pet", 1.5750),
-        ("diamond", 2.419),
-    ];
     match desc.params.get(name) {
         None => default,
         Some(MatParam::Float(v)) => *v,
         Some(MatParam::Str(s)) => {
-            NAMED.iter().find(|(n, _)| n.eq_ignore_ascii_case(s)).map(|(_, v)| *v).unwrap_or_else(|| {
+            NAMED_IORS.iter().find(|(n, _)| n.eq_ignore_ascii_case(s)).map(|(_, v)| *v).unwrap_or_else(|| {
                 warn(&format!("unknown {name} \"{s}\"; {default} used"));
                 default
             })
