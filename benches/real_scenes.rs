@@ -12,10 +12,10 @@
 #[allow(dead_code)] // the shared helpers this bench does not use (built-in scenes, the HDR-lit helmet)
 mod common;
 
+use mislab::render::settings::{Heuristic, Mode, Settings, Strategy};
 use mislab::render::Renderer;
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{self, LoadOptions};
-use mislab::settings::{Heuristic, Mode, Settings, Strategy};
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 
 const SCENES: [(&str, f64); 7] = [
     ("damagedhelmet_grey", 1.0),

@@ -7,10 +7,10 @@
 mod common;
 
 use common::env_or;
-use mislab::features::Features;
+use mislab::render::features::Features;
+use mislab::render::settings::{Mode, Settings};
 use mislab::render::Renderer;
-use mislab::settings::{Mode, Settings};
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::time::Instant;
 
 fn main() {
@@ -42,7 +42,7 @@ fn main() {
         let t = Instant::now();
         let mut r = Renderer::new(&ctx, &gs, s.camera.clone(), settings).expect("renderer");
         let spec_compile = t.elapsed().as_secs_f64();
-        let key = mislab::features::PipelineKey::generic();
+        let key = mislab::render::features::PipelineKey::generic();
         if let Some(p) = &generic {
             r.insert_pipeline(key, p.clone());
         }

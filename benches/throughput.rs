@@ -4,9 +4,9 @@
 
 mod common;
 
+use mislab::render::settings::{Mode, Settings};
 use mislab::render::Renderer;
-use mislab::settings::{Mode, Settings};
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 
 fn main() {
     let seconds: f64 = common::env_or("MISLAB_BENCH_SECONDS", 10.0);

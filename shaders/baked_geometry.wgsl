@@ -1,4 +1,4 @@
-// baked_geometry.wgsl — traversal of a scene baked into the shader (Features::flat). src/baked.rs generates the
+// baked_geometry.wgsl — traversal of a scene baked into the shader (Features::flat). src/render/baked.rs generates the
 // real one per scene, every primitive's intersection test unrolled with its data as literals; this stub stands in
 // for modules built without a scene (the generic pipeline, probes), where FLAT_SCENE is false.
 

@@ -12,7 +12,7 @@
 // Mitsuba 3 evaluates them), and h is sampled from D(h)·cosθh (Walter et al. 2007, eqs. 28-29, anisotropic as
 // pbrt-v3): pdf(wi) = D(h)·cosθh / (4 |wo·h|).
 // Smooth (max α < DELTA_ALPHA): an exact mirror, a delta lobe that only conductor_sample reaches (eval, pdf 0).
-// Reached only where the scene has a conductor (HAS_CONDUCTOR, src/features.rs).
+// Reached only where the scene has a conductor (HAS_CONDUCTOR, src/render/features.rs).
 
 /// Anisotropic GGX D(h). Written as the isotropic ggx_d with the stretched slope, without 1 − cos²θ.
 fn aniso_ggx_d(h: vec3<f32>, au: f32, av: f32) -> f32 {

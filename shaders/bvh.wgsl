@@ -1,7 +1,7 @@
 // bvh.wgsl — BVH2 traversal (closest hit, any hit), ray–triangle/sphere/quad intersection and ray-origin offsetting.
 // Needs common.wgsl and geometry_bindings.wgsl. Every loop has an explicit bound: lavapipe has no watchdog.
 
-/// A BVH2 node holding both children's boxes (mirrors `GpuBvhNode` in src/bvh.rs, same field names). Per child:
+/// A BVH2 node holding both children's boxes (mirrors `GpuBvhNode` in src/accel/bvh.rs, same field names). Per child:
 /// count > 0: leaf over prim_refs[first .. first + count]; count == 0 && first != INVALID: interior node
 /// bvh_nodes[first]; count == 0 && first == INVALID: no child (single-leaf and empty trees), skipped by the flag.
 struct BvhNode {
@@ -15,7 +15,7 @@ struct BvhNode {
     r_count: u32,
 }
 
-/// Traversal stack entries; src/bvh.rs (BVH_STACK_SIZE) guarantees tree depth ≤ this, so pushes never overflow.
+/// Traversal stack entries; src/accel/bvh.rs (BVH_STACK_SIZE) guarantees tree depth ≤ this, so pushes never overflow.
 const BVH_STACK_SIZE: u32 = 64u;
 /// Invocations per workgroup that may trace rays (every tracing entry point has at most this many).
 const BVH_LANES: u32 = 64u;
@@ -112,7 +112,7 @@ fn intersect_triangle(r: TraceRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, 
 }
 
 /// The end of the watertight test, from the edge functions u, v, w (opposite v0, v1, v2) and the sheared z of the
-/// vertices. Baked meshes (src/baked.rs) compute each shared vertex and edge once per ray and call this per
+/// vertices. Baked meshes (src/render/baked.rs) compute each shared vertex and edge once per ray and call this per
 /// triangle: the same values, bit for bit, as `intersect_triangle`.
 fn tri_hit(u: f32, v: f32, w: f32, az: f32, bz: f32, cz: f32, t_max: f32) -> vec4<f32> {
     // Branch-free: lavapipe runs both sides of every branch anyway, and selects are cheaper than its masks.
@@ -125,7 +125,7 @@ fn tri_hit(u: f32, v: f32, w: f32, az: f32, bz: f32, cz: f32, t_max: f32) -> vec
 }
 
 /// Clips the ray parameter interval `span` to the half-space n·x ≤ dist (unit n): one face of a convex solid
-/// (src/convex_solids.rs; Haines 1991). The interval is empty (x ≥ y) once the ray misses the solid.
+/// (src/accel/convex_solids.rs; Haines 1991). The interval is empty (x ≥ y) once the ray misses the solid.
 fn clip_to_half_space(span: vec2<f32>, r: TraceRay, n: vec3<f32>, dist: f32) -> vec2<f32> {
     let dn = dot(n, r.d);
     let s = dist - dot(n, r.o);   // ≥ 0 when the origin is inside
@@ -260,7 +260,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
                 continue;
             }
             if count > 0u {
-                // In a triangle-only scene prim_refs[j] == j (src/bvh.rs into_leaf_order): a leaf's triangles are
+                // In a triangle-only scene prim_refs[j] == j (src/accel/bvh.rs into_leaf_order): a leaf's triangles are
                 // read directly, with no prim_refs load and no switch on the kind; storage loads dominate a BVH
                 // sample on lavapipe (docs/profile-bvh.md). Chosen per pipeline, not per leaf: a branch between
                 // the two paths costs lavapipe both (measured 13 % slower than always reading prim_refs).

@@ -1,4 +1,4 @@
-// common.wgsl — constants and the structs shared with Rust (mirrored in src/gpu_types.rs, layout-tested).
+// common.wgsl — constants and the structs shared with Rust (mirrored in src/gpu/types.rs, layout-tested).
 
 const PI: f32 = 3.14159265358979323846;
 const INV_PI: f32 = 0.31830988618379067154;
@@ -25,7 +25,7 @@ const LIGHT_SPOT: u32 = 4u;
 const LIGHT_DIRECTIONAL: u32 = 5u;
 const LIGHT_ENVIRONMENT: u32 = 6u;
 
-// Settings tags (mirrored by the Rust enums in src/settings.rs).
+// Settings tags (mirrored by the Rust enums in src/render/settings.rs).
 const MODE_DIRECT: u32 = 0u;
 const MODE_PATH: u32 = 1u;
 
@@ -150,7 +150,7 @@ struct Light {
     _pad2: u32,
 }
 
-/// A light-tree node (src/light_tree.rs): bounds, power φ, orientation cone (axis, cos θo) and emission spread cos θe
+/// A light-tree node (src/accel/light_tree.rs): bounds, power φ, orientation cone (axis, cos θo) and emission spread cos θe
 /// of the lights below. Interior: first child next, second at `second`; leaf (second = INVALID): light `light`.
 struct LightNode {
     lo: vec3<f32>,
@@ -259,7 +259,7 @@ fn luminance(c: vec3<f32>) -> f32 { return dot(c, vec3<f32>(0.2126, 0.7152, 0.07
 fn sqr(x: f32) -> f32 { return x * x; }
 fn safe_sqrt(x: f32) -> f32 { return sqrt(max(x, 0.0)); }
 
-// ---- Scene features: pipeline-overridable constants (src/features.rs sets them). The default (true)
+// ---- Scene features: pipeline-overridable constants (src/render/features.rs sets them). The default (true)
 // compiles every path; a specialised pipeline sets the ones a scene does not need to false, and the
 // driver removes that code. On lavapipe this matters: it runs SIMD lanes under masks, so code in a
 // branch that no lane takes still costs time unless it is compiled out.
@@ -289,5 +289,5 @@ override HAS_ALPHA: bool = true;
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.
 override MANY_LIGHTS: bool = true;
-/// Scenes of a few primitives, baked into the shader: traversal is the generated `baked_traverse` (src/baked.rs).
+/// Scenes of a few primitives, baked into the shader: traversal is the generated `baked_traverse` (src/render/baked.rs).
 override FLAT_SCENE: bool = false;

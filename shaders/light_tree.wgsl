@@ -1,4 +1,4 @@
-// light_tree.wgsl — `--light-select tree`: the descent of the light tree src/light_tree.rs builds (its module docs
+// light_tree.wgsl — `--light-select tree`: the descent of the light tree src/accel/light_tree.rs builds (its module docs
 // give the importance), and the pmf of a given light from a shading point, for MIS. Called by select_light /
 // light_pmf in lights.wgsl.
 //

@@ -1,5 +1,5 @@
 // samplers.wgsl — stateless sample sequences: (pixel, sample index, dimension) → u ∈ [0,1). CPU twin and
-// tables: src/samplers.rs (`sampler_data`, group 1 binding 3, declared in shading_bindings.wgsl).
+// tables: src/render/samplers.rs (`sampler_data`, group 1 binding 3, declared in shading_bindings.wgsl).
 //
 // Dimension allocation. Every sampler sees the same meaning per dimension, in blocks of four (the padded Sobol
 // sampler gives each block its own shuffled 4D Sobol pattern):
@@ -36,7 +36,7 @@ const DIM_BSDF_UV: u32 = 5u;
 const DIM_RR: u32 = 7u;
 const DIM_MIS_CHOICE: u32 = 8u;
 
-// Layout of sampler_data (src/samplers.rs has the same constants; tests/samplers.rs compares them).
+// Layout of sampler_data (src/render/samplers.rs has the same constants; tests/samplers.rs compares them).
 const SOBOL_OFFSET: u32 = 0u;
 const SOBOL_TABLE_WORDS: u32 = 2048u;
 const HALTON_OFFSET: u32 = 2048u;
@@ -97,7 +97,7 @@ fn sobol_block_dim(dim: u32) -> u32 {
     return select((comp + 3u) & 3u, comp, dim < 4u);
 }
 
-/// Sobol dimensions 2 and 3 (sd = 2, 3) without tables: the XOR of the generator-matrix columns (src/samplers.rs
+/// Sobol dimensions 2 and 3 (sd = 2, 3) without tables: the XOR of the generator-matrix columns (src/render/samplers.rs
 /// `sobol_matrix`) of the index's set bits, unrolled. No loads (a storage-buffer read is a loop over the lanes on
 /// lavapipe: the four byte-table reads this replaces cost more than these 32 masked XORs) and no loop (every loop
 /// iteration counts against lavapipe's per-invocation budget).

@@ -1,5 +1,5 @@
 // scene_data.wgsl — how shading code reads the scene: one accessor per table. This file reads the storage
-// buffers; for scenes small enough to bake (Features::flat) src/baked.rs generates a replacement with the same
+// buffers; for scenes small enough to bake (Features::flat) src/render/baked.rs generates a replacement with the same
 // functions returning literals, (its `baked_geometry.wgsl` replacement has every intersection test unrolled). lavapipe runs a
 // storage-buffer read as a loop over the SIMD lanes (each lane's bounds check and load in turn), so in the
 // bounce loop one read costs about as much as a hundred arithmetic operations; a literal costs nothing and a

@@ -1,43 +1,20 @@
 //! mislab: a GPU compute-shader Monte Carlo renderer for seeing, measuring and trusting sampling strategies.
 //!
-//! Data flows one way (see `../shared/DESIGN.md`): scene file → [`scene::Scene`] → [`gpu_scene::GpuScene`]
-//! (+ [`bvh`], [`lights`]) → [`render::Renderer`] (progressive accumulation) → [`film`] (PNG / EXR).
+//! Data flows one way (see `../shared/DESIGN.md`): scene file → [`scene::Scene`] → [`render::scene_data::SceneData`]
+//! (+ [`accel::bvh`], [`render::lights`]) → [`render::gpu_scene::GpuScene`] → [`render::Renderer`] (progressive
+//! accumulation) → [`render::film`] (PNG / EXR).
+//!
+//! The folders are the layers, each using only those below it: [`io`] (files) and [`gpu`] (the device and the
+//! structs shared with WGSL) at the bottom; [`scene`] (loaders) and [`accel`] (BVH, light tree) on
+//! them; [`render`] (the renderer); [`state`] (checkpointed and split renders); [`lab`] (bench, references,
+//! figures, stress) and [`viewer`] at the top. [`testkit`] (chi-square, probes, metrics) serves the tests and the lab.
 
-pub mod baked;
-pub mod bench;
-pub mod bindings;
-pub mod bvh;
-pub mod chi2;
-pub mod cli_values;
-pub mod compare;
-pub mod convex_solids;
-pub mod exr_image;
-pub mod features;
-pub mod figure;
-pub mod film;
+pub mod accel;
 pub mod gpu;
-pub mod gpu_scene;
-pub mod gpu_timer;
-pub mod gpu_types;
-pub mod input_file;
-pub mod light_tree;
-pub mod lights;
-pub mod metrics;
-pub mod output_file;
-pub mod pipeline_cache;
-pub mod probe;
-pub mod progressive;
-pub mod reachability;
-pub mod reference;
+pub mod io;
+pub mod lab;
 pub mod render;
-pub mod render_error;
-pub mod sampler_figure;
-pub mod samplers;
 pub mod scene;
-pub mod scene_data;
-pub mod settings;
-pub mod shaders;
 pub mod state;
-pub mod stress;
-pub mod suite_inputs;
+pub mod testkit;
 pub mod viewer;

@@ -1,13 +1,13 @@
 //! The `mislab` command line: render, info (and the subcommands later issues add).
 
 use clap::{Args, Parser, Subcommand};
-use mislab::film::Tonemap;
 use mislab::gpu::{self, GpuContext};
-use mislab::progressive::{self, Budget};
+use mislab::render::film::Tonemap;
+use mislab::render::progressive::{self, Budget};
+use mislab::render::settings::*;
 use mislab::render::Renderer;
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{self, Environment, SceneSpec};
-use mislab::settings::*;
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -40,17 +40,17 @@ enum Command {
     /// Render a high-quality reference (MIS, Sobol) to EXR; the header records spp and settings.
     // clap's own usage line would show --spp as required and hide --time, its equal alternative.
     #[command(override_usage = "mislab reference [SCENE] -o <OUTPUT> (--spp <N> | --time <SECONDS>) [OPTIONS]")]
-    Reference(mislab::reference::ReferenceArgs),
+    Reference(mislab::lab::reference::ReferenceArgs),
     /// Combine the state files of `render --part K/N` runs into one image and state; --status DIR reports progress.
     Merge(mislab::state::merge::MergeArgs),
     /// Compare an image with a reference: mean ratio and relMSE of N×N-block means, per channel.
-    Compare(mislab::compare::CompareArgs),
+    Compare(mislab::lab::compare::CompareArgs),
     /// Run time against error: configurations × spp ladder × seeds, CSV/JSON and plots.
-    Bench(mislab::bench::BenchArgs),
+    Bench(mislab::lab::bench::BenchArgs),
     /// Open the interactive viewer: the image converges while a panel switches estimators live.
     View(mislab::viewer::ViewArgs),
     /// Reproduce a lecture figure: veach (light / BSDF / balance / power), area-vs-cosine, samplers.
-    Figure(mislab::figure::FigureArgs),
+    Figure(mislab::lab::figure::FigureArgs),
     /// Run the numerical stress suite (extreme scales, angles, lights, degenerate geometry, broken
     /// environment maps, extreme sample statistics) and print a table; exit 1 if any case fails.
     Stress {
@@ -77,10 +77,10 @@ struct RenderArgs {
     #[arg(long)]
     force: bool,
     /// Samples per pixel [default: 64 unless --time is given].
-    #[arg(long, conflicts_with = "time", value_parser = mislab::cli_values::spp)]
+    #[arg(long, conflicts_with = "time", value_parser = mislab::io::cli_values::spp)]
     spp: Option<u32>,
     /// Render for this many seconds (after start-up and shader compilation).
-    #[arg(long, value_parser = mislab::cli_values::seconds)]
+    #[arg(long, value_parser = mislab::io::cli_values::seconds)]
     time: Option<f64>,
     /// Tonemapper for PNG output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
@@ -126,12 +126,12 @@ fn main() -> ExitCode {
         Command::Render(args) => render(args),
         Command::Info { scene } => info(scene),
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
-        Command::Reference(args) => mislab::reference::run(&args).map_err(bad),
+        Command::Reference(args) => mislab::lab::reference::run(&args).map_err(bad),
         Command::Merge(args) => mislab::state::merge::run(&args).map_err(bad),
-        Command::Compare(args) => mislab::compare::run(&args).map_err(bad),
-        Command::Bench(args) => mislab::bench::run(&args).map(|_| 0).map_err(bad),
+        Command::Compare(args) => mislab::lab::compare::run(&args).map_err(bad),
+        Command::Bench(args) => mislab::lab::bench::run(&args).map(|_| 0).map_err(bad),
         Command::Stress { filter } => stress(filter.as_deref()),
-        Command::Figure(args) => mislab::figure::run(&args).map(|_| 0).map_err(bad),
+        Command::Figure(args) => mislab::lab::figure::run(&args).map(|_| 0).map_err(bad),
     };
     match result {
         Ok(code) => ExitCode::from(code),
@@ -154,12 +154,12 @@ fn load_scene(spec: &SceneSpec) -> Result<scene::Scene, Failure> {
 fn stress(filter: Option<&str>) -> Result<u8, Failure> {
     let ctx = gpu_context()?;
     eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
-    let outcomes =
-        mislab::stress::run(&ctx, filter, |o| eprintln!("{}", mislab::stress::progress_line(o))).map_err(bad)?;
+    let outcomes = mislab::lab::stress::run(&ctx, filter, |o| eprintln!("{}", mislab::lab::stress::progress_line(o)))
+        .map_err(bad)?;
     if outcomes.is_empty() {
         return Err(bad(format!("--filter '{}' matches no stress case", filter.unwrap_or_default())));
     }
-    println!("{}", mislab::stress::table(&outcomes));
+    println!("{}", mislab::lab::stress::table(&outcomes));
     let failed = outcomes.iter().filter(|o| !o.pass).count();
     println!(
         "{} cases, {} passed, {} failed, {} NaN/Inf samples in all",
@@ -179,7 +179,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         return Err(bad(format!("{}: unknown output format (use .png or .exr)", args.output.display())));
     }
     // Before any work: a missing directory or a read-only file would otherwise be found after the render.
-    let target = mislab::output_file::check(&args.output, args.force).map_err(bad)?;
+    let target = mislab::io::output_file::check(&args.output, args.force).map_err(bad)?;
     if ext.as_deref() == Some("exr") && settings.exposure != 0.0 {
         eprintln!("note: --exposure is ignored for EXR output (linear radiance); it applies to PNG and the viewer");
     }
@@ -187,8 +187,8 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         (Some(0), _) => return Err(bad("--spp must be at least 1")),
         (Some(n), _) => {
             // Hammersley and stratified build their points for a fixed count: refuse or round with a message.
-            let used = mislab::samplers::check_spp(settings.sampler, n).map_err(bad)?;
-            let note = mislab::samplers::spp_message(settings.sampler, n, used);
+            let used = mislab::render::samplers::check_spp(settings.sampler, n).map_err(bad)?;
+            let note = mislab::render::samplers::spp_message(settings.sampler, n, used);
             if !note.is_empty() {
                 eprintln!("note: {note}");
             }
@@ -260,7 +260,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
             n => format!(" ({:.0} B/triangle)", data.bvh_bytes() as f64 / n as f64),
         },
     );
-    if let Some(w) = mislab::reachability::unreachable_light_warning(&data, &settings) {
+    if let Some(w) = mislab::render::reachability::unreachable_light_warning(&data, &settings) {
         eprintln!("warning: {w}");
     }
     let scene_hash = mislab::state::scene_hash(&data, &scene.camera);
@@ -316,7 +316,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         eprintln!("wrote state {} (samples {}..{})", s.path().display(), s.range().0, renderer.samples());
     }
     let film = renderer.film(&ctx).map_err(|e| bad(e.to_string()))?;
-    let attributes = mislab::reference::header_attributes(&args.scene, &settings, &stats);
+    let attributes = mislab::lab::reference::header_attributes(&args.scene, &settings, &stats);
     film.save_to(&target, settings.exposure, args.tonemap, &attributes).map_err(bad)?;
     eprintln!(
         "{} spp in {:.2} s: {:.2} M samples/s, {:.2} Mrays/s, {} NaN/Inf samples",
@@ -377,7 +377,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
         );
         // Device memory per triangle: BVH (nodes + references), geometry (vertices) and per-triangle shading data.
         let tris = data.tri_shading.len().max(1) as f64;
-        let sizes = mislab::gpu_scene::binding_sizes(&data);
+        let sizes = mislab::render::gpu_scene::binding_sizes(&data);
         let (bvh, geom, shading) = (sizes[0] + sizes[1], sizes[2], sizes[5]);
         println!(
             "memory per triangle: BVH {:.0} B, geometry {:.0} B, shading {:.0} B, total {:.0} B; every scene buffer {:.1} MiB",
@@ -387,7 +387,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             (bvh + geom + shading) as f64 / tris,
             sizes.iter().sum::<u64>() as f64 / (1u64 << 20) as f64
         );
-        let features = mislab::features::Features::of(&data);
+        let features = mislab::render::features::Features::of(&data);
         println!("features (code paths compiled into its specialised pipelines): {}", features.describe());
     }
     Ok(0)

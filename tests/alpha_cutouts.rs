@@ -6,10 +6,10 @@
 
 mod common;
 
-use mislab::features::Features;
+use mislab::render::features::Features;
+use mislab::render::scene_data::SceneData;
+use mislab::render::settings::{Mode, Settings, Strategy};
 use mislab::scene::{self, LoadOptions, Scene};
-use mislab::scene_data::SceneData;
-use mislab::settings::{Mode, Settings, Strategy};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 

@@ -10,7 +10,7 @@
 //! Also: a scene larger than the device's storage-buffer binding limit is refused with an error naming the
 //! limit, end to end with a generated texture, and at the unit level with a synthetic `SceneData`.
 
-use mislab::{gpu_scene::check_binding_sizes, scene_data::SceneData};
+use mislab::render::{gpu_scene::check_binding_sizes, scene_data::SceneData};
 use std::collections::BTreeMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};

@@ -9,8 +9,8 @@ mod common;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
+use mislab::render::settings::{Settings, Strategy};
 use mislab::scene::{self, coated, Environment, LoadOptions, MaterialKind, ALPHA_MIN};
-use mislab::settings::{Settings, Strategy};
 use std::f64::consts::PI;
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -176,7 +176,7 @@ fn coated_eval_matches_cpu_and_is_reciprocal() {
         .copied()
         .filter(|f| ["common.wgsl", "warps.wgsl"].contains(f) || f.starts_with("bsdf"))
         .collect();
-    let lib = mislab::shaders::compose(&files, PROBE);
+    let lib = mislab::render::shaders::compose(&files, PROBE);
     let params = [
         Params { r: DVec3::new(0.243, 0.059, 0.0008), eta: 1.5, au: 0.2, av: 0.2 },
         Params { r: DVec3::ONE, eta: 1.5, au: 0.01, av: 0.01 },
@@ -203,7 +203,7 @@ fn coated_eval_matches_cpu_and_is_reciprocal() {
             which.push(k);
         }
     }
-    let out: Vec<ProbeOut> = mislab::probe::Probe::new(&ctx)
+    let out: Vec<ProbeOut> = mislab::testkit::probe::Probe::new(&ctx)
         .map(&lib, "ProbeIn", "ProbeOut", "probe_coated", &inputs, None)
         .unwrap_or_else(|e| panic!("{e}"));
     let (mut worst_f, mut worst_pdf, mut worst_rec, mut worst_fi, mut worst_s) = (0f64, 0f64, 0f64, 0f64, 0f64);
@@ -387,8 +387,8 @@ fn coated_render_has_no_nan() {
         let a = alphas[i % alphas.len()];
         m.kind = MaterialKind::CoatedDiffuse { eta: etas[i % etas.len()], alpha_u: a, alpha_v: a.max(ALPHA_MIN) * 2.0 };
     }
-    let data = mislab::scene_data::SceneData::build(&s);
-    let f = mislab::features::Features::of(&data);
+    let data = mislab::render::scene_data::SceneData::build(&s);
+    let f = mislab::render::features::Features::of(&data);
     assert!(f.coated_diffuse && !f.conductor, "features: {}", f.describe());
     // MIS runs both the light samples (bsdf_eval, bsdf_pdf) and the BSDF samples (bsdf_sample); one pipeline.
     let settings = Settings { strategy: Strategy::Mis, ..common::small(48, 48) };

@@ -6,9 +6,9 @@
 
 mod common;
 
+use mislab::render::scene_data::SceneData;
+use mislab::render::settings::{Mode, Settings, Strategy};
 use mislab::scene::{self, Environment, LoadOptions, MaterialKind};
-use mislab::scene_data::SceneData;
-use mislab::settings::{Mode, Settings, Strategy};
 
 /// A row of conductors in a white furnace (constant radiance 1, nothing else): k = 10⁴ makes F ≈ 1, so each
 /// sphere's pixels are the directional albedo of its single-scattering GGX surface (a convex sphere sees only the
@@ -134,7 +134,7 @@ fn conductor_white_furnace() {
 
 /// Mean (red) of a 4×4 block of pixels around the centre of the sphere at x = cx (camera at z = 9, vfov 20°),
 /// and the standard error of that mean from the pixels' sample variances.
-fn sphere_mean(film: &mislab::film::Film, w: u32, h: u32, cx: f32) -> (f64, f64) {
+fn sphere_mean(film: &mislab::render::film::Film, w: u32, h: u32, cx: f32) -> (f64, f64) {
     let px = (w as f32 * 0.5 + cx / (9.0 * 10f32.to_radians().tan()) * h as f32 * 0.5) as i32;
     let (mut sum, mut var, mut n) = (0.0, 0.0, 0.0);
     for y in (h as i32 / 2 - 2)..(h as i32 / 2 + 2) {
@@ -357,7 +357,7 @@ fn glass_scene_renders_and_warns() {
         let film = common::render(&ctx, &s, &settings, 16);
         let bad: u32 = film.nonfinite.iter().sum();
         assert_eq!(bad, 0, "{strategy:?}: NaN/Inf samples");
-        let warning = mislab::reachability::unreachable_light_warning(&data, &settings);
+        let warning = mislab::render::reachability::unreachable_light_warning(&data, &settings);
         if strategy == Strategy::Light {
             let w = warning.expect("light sampling must warn about light behind glass");
             assert!(w.contains("--strategy light") && w.contains("glass"), "{w}");

@@ -2,11 +2,11 @@
 //! reference on random soups, single primitives, the empty scene and DamagedHelmet; ray-origin offsetting at 1e5.
 
 use glam::{DVec3, Vec3};
-use mislab::bvh::reference::{self, Ray, RefHit, Scene};
-use mislab::bvh::{self, Bvh, EMPTY_CHILD};
+use mislab::accel::bvh::reference::{self, Ray, RefHit, Scene};
+use mislab::accel::bvh::{self, Bvh, EMPTY_CHILD};
+use mislab::gpu::types::{make_prim, GpuQuad, GpuSphere, INVALID, PRIM_SPHERE, PRIM_TRIANGLE};
 use mislab::gpu::GpuContext;
-use mislab::gpu_types::{make_prim, GpuQuad, GpuSphere, INVALID, PRIM_SPHERE, PRIM_TRIANGLE};
-use mislab::probe::{GeometryBuffers, Probe};
+use mislab::testkit::probe::{GeometryBuffers, Probe};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -90,7 +90,7 @@ fn probe_spawn(s: ProbeSpawn) -> ProbeSpawnOut {
 fn probe_source() -> String {
     // Geometry only: no textures, so no cut-outs (alpha.wgsl needs the shading bindings).
     let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
-    mislab::shaders::compose(
+    mislab::render::shaders::compose(
         &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "baked_geometry.wgsl"],
         &format!("{no_alpha}{PROBE_WGSL}"),
     )
@@ -129,7 +129,7 @@ struct Culled {
 }
 
 fn bounding_sphere(g: &Geometry, prim: u32) -> (DVec3, f64) {
-    let i = (prim & mislab::gpu_types::PRIM_INDEX_MASK) as usize;
+    let i = (prim & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
     match prim >> 30 {
         PRIM_TRIANGLE => {
             let v = g.tris[i].map(|p| p.as_dvec3());
@@ -238,7 +238,7 @@ fn rel(a: f64, b: f64) -> f64 {
 /// Returns that error unit along the ray and in the primitive's parameters (K ulps each).
 fn f32_error_units(g: &Geometry, prim: u32, r: &Ray, t: f64) -> (f64, f64) {
     const K: f64 = 8.0 * f32::EPSILON as f64 * 0.5;
-    let i = (prim & mislab::gpu_types::PRIM_INDEX_MASK) as usize;
+    let i = (prim & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
     let dn = r.d.normalize();
     let hit = r.o + t * r.d;
     let (cos, size) = match prim >> 30 {
@@ -392,7 +392,7 @@ fn v3(rng: &mut Pcg64, lo: f32, hi: f32) -> Vec3 {
 
 /// A random point on a primitive (for aiming rays so that most hit).
 fn point_on(g: &Geometry, prim: u32, rng: &mut Pcg64) -> DVec3 {
-    let i = (prim & mislab::gpu_types::PRIM_INDEX_MASK) as usize;
+    let i = (prim & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
     match prim >> 30 {
         PRIM_TRIANGLE => {
             let v = g.tris[i].map(|p| p.as_dvec3());
@@ -461,7 +461,7 @@ fn make_rays(g: &Geometry, n: usize, seed: u64) -> Vec<ProbeRay> {
 }
 
 fn is_included(g: &Geometry, p: u32) -> bool {
-    let i = (p & mislab::gpu_types::PRIM_INDEX_MASK) as usize;
+    let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
     match p >> 30 {
         PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]).is_some(),
         PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]).is_some(),
@@ -581,7 +581,7 @@ fn check_structure(g: &Geometry, b: &Bvh) {
                 for k in first..first + count {
                     seen[k as usize] += 1;
                     let p = b.prim_refs[k as usize];
-                    let i = (p & mislab::gpu_types::PRIM_INDEX_MASK) as usize;
+                    let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
                     let pb = match p >> 30 {
                         PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]),
                         PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]),
@@ -633,7 +633,7 @@ fn build_invariants() {
 fn leaf_order_makes_triangle_refs_the_identity() {
     let g = helmet();
     let mut b = g.build();
-    let order = mislab::bvh::into_leaf_order(&mut b, g.tris.len());
+    let order = mislab::accel::bvh::into_leaf_order(&mut b, g.tris.len());
     assert!(b.prim_refs.iter().enumerate().all(|(j, &r)| r == j as u32), "prim_refs[j] == j");
     let mut seen = vec![false; g.tris.len()];
     order.iter().for_each(|&o| seen[o as usize] = true);
@@ -644,7 +644,7 @@ fn leaf_order_makes_triangle_refs_the_identity() {
     let soup = soup(2);
     let mut b = soup.build();
     let before = b.prim_refs.clone();
-    let order = mislab::bvh::into_leaf_order(&mut b, soup.tris.len());
+    let order = mislab::accel::bvh::into_leaf_order(&mut b, soup.tris.len());
     for (x, y) in before.iter().zip(&b.prim_refs) {
         if x >> 30 == 0 {
             assert_eq!(order[*y as usize], *x, "a triangle reference names the same triangle");
@@ -1088,7 +1088,7 @@ fn probe_reports_sentinel_and_shader_errors() {
                }";
     let input: Vec<u32> = (0..8).collect();
     let bytes = probe
-        .run(&mislab::probe::ProbeJob {
+        .run(&mislab::testkit::probe::ProbeJob {
             source: src,
             entry: "main",
             inputs: &[bytemuck::cast_slice(&input)],
@@ -1103,13 +1103,13 @@ fn probe_reports_sentinel_and_shader_errors() {
         out,
         vec![
             0,
-            mislab::probe::PROBE_SENTINEL,
+            mislab::testkit::probe::PROBE_SENTINEL,
             4,
-            mislab::probe::PROBE_SENTINEL,
+            mislab::testkit::probe::PROBE_SENTINEL,
             8,
-            mislab::probe::PROBE_SENTINEL,
+            mislab::testkit::probe::PROBE_SENTINEL,
             12,
-            mislab::probe::PROBE_SENTINEL
+            mislab::testkit::probe::PROBE_SENTINEL
         ]
     );
     // A map over more elements than one dispatch row would hold is not needed here; check a plain map and errors.

@@ -1,12 +1,12 @@
-//! Convex-solid detection (src/convex_solids.rs): which triangle meshes shadow rays may test as half-space
+//! Convex-solid detection (src/accel/convex_solids.rs): which triangle meshes shadow rays may test as half-space
 //! intersections, and that the Cornell box's blocks are found and agree with their triangles.
 
 mod common;
 
 use glam::{DVec3, Vec3};
-use mislab::convex_solids::{convex_solids, ConvexSolid};
-use mislab::gpu_types::INVALID;
-use mislab::scene_data::SceneData;
+use mislab::accel::convex_solids::{convex_solids, ConvexSolid};
+use mislab::gpu::types::INVALID;
+use mislab::render::scene_data::SceneData;
 
 /// Triangles as the flattened `[x, y, z, 0]` triples `convex_solids` reads.
 fn flatten(tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {

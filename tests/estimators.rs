@@ -7,13 +7,13 @@
 mod common;
 use common::*;
 use glam::{DVec3, Vec3};
-use mislab::film::Film;
 use mislab::gpu::GpuContext;
+use mislab::render::film::Film;
+use mislab::render::settings::*;
 use mislab::render::Renderer;
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::builtin::{VEACH_LIGHTS, VEACH_PLATES};
 use mislab::scene::{Camera, Material, Quad, Scene, Sphere};
-use mislab::settings::*;
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::sync::{Mutex, OnceLock};
 
 /// Family-wise level of every test in this file.
@@ -353,7 +353,7 @@ fn sphere_irradiance(p: DVec3, n: DVec3, c: DVec3, r: f64, l: f64) -> f64 {
 }
 
 /// Irradiance at p (normal n) from a Lambertian polygon (Lambert's formula; the stress suite's closed form).
-use mislab::stress::polygon_irradiance;
+use mislab::lab::stress::polygon_irradiance;
 
 /// Radiance reflected by the Lambert plane at p towards any direction: ρ/π·(E_sphere + E_quad).
 fn plane_radiance(p: DVec3) -> f64 {

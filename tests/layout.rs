@@ -1,14 +1,14 @@
 //! Every struct shared between Rust and WGSL has the same size and member offsets on both sides (naga's
 //! own layout of the WGSL), and every WGSL tag constant equals its Rust enum discriminant. No GPU needed.
 
-use mislab::bvh::GpuBvhNode;
-use mislab::gpu_types::*;
-use mislab::settings::*;
+use mislab::accel::bvh::GpuBvhNode;
+use mislab::gpu::types::*;
+use mislab::render::settings::*;
 use std::mem::{offset_of, size_of};
 
 fn module() -> naga::Module {
     let src = mislab::render::render_source();
-    mislab::shaders::validate(&src).unwrap_or_else(|e| panic!("render module does not validate:\n{e}"))
+    mislab::render::shaders::validate(&src).unwrap_or_else(|e| panic!("render module does not validate:\n{e}"))
 }
 
 /// (size, [(member name, offset)]) of a WGSL struct by name.
@@ -91,7 +91,7 @@ fn shared_structs_match() {
     check!(
         m,
         "LightNode",
-        mislab::light_tree::GpuLightNode,
+        mislab::accel::light_tree::GpuLightNode,
         [lo, phi, hi, second, axis, cos_o, cos_e, light, two_sided, count]
     );
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
@@ -213,7 +213,7 @@ fn tag_constants_match() {
 /// generator and the element sizes typed into the table against naga's own layout.
 #[test]
 fn bindings_match_the_table() {
-    use mislab::bindings::{self, Access};
+    use mislab::render::bindings::{self, Access};
     let m = module();
     let mut seen = Vec::new();
     for (_, var) in m.global_variables.iter() {
@@ -246,5 +246,5 @@ fn bindings_match_the_table() {
             b.binding
         );
     }
-    assert_eq!(bindings::SCENE.len(), mislab::gpu_scene::binding_sizes(&Default::default()).len());
+    assert_eq!(bindings::SCENE.len(), mislab::render::gpu_scene::binding_sizes(&Default::default()).len());
 }

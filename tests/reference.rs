@@ -6,7 +6,7 @@
 
 mod common;
 use common::*;
-use mislab::settings::*;
+use mislab::render::settings::*;
 use std::path::Path;
 
 fn reference(name: &str) -> Vec<[f32; 3]> {
@@ -17,7 +17,7 @@ fn reference(name: &str) -> Vec<[f32; 3]> {
 }
 
 /// (raw relMSE, noise part, debiased relMSE) of a film against reference block means.
-fn compare(film: &mislab::film::Film, r: &[[f32; 3]]) -> (f64, f64, f64) {
+fn compare(film: &mislab::render::film::Film, r: &[[f32; 3]]) -> (f64, f64, f64) {
     let (mut raw, mut noise) = (0.0, 0.0);
     for i in 0..r.len() {
         let var = film.variance_of_mean(i).unwrap();

@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use mislab::settings::*;
+use mislab::render::settings::*;
 
 /// Furnace: a sphere of albedo 1 under a constant white sky reflects exactly 1 in every direction, so
 /// every pixel's expected value is 1 — in direct mode (one bounce, nothing occludes a convex sphere)
@@ -60,7 +60,7 @@ fn same_seed_same_bits_other_seed_other_bits() {
     let s = small(48, 48);
     let a = render(&ctx, &scene, &s, 8);
     let b = render(&ctx, &scene, &s, 8);
-    let bits = |f: &mislab::film::Film| f.mean.iter().flat_map(|c| c.map(f32::to_bits)).collect::<Vec<_>>();
+    let bits = |f: &mislab::render::film::Film| f.mean.iter().flat_map(|c| c.map(f32::to_bits)).collect::<Vec<_>>();
     assert_eq!(bits(&a), bits(&b), "the same seed and settings must give the same image bit for bit");
     let c = render(&ctx, &scene, &Settings { seed: 7, ..s }, 8);
     assert_ne!(bits(&a), bits(&c), "a different seed must change the image");
@@ -108,7 +108,9 @@ fn specialised_and_generic_pipelines_agree() {
         // Russian roulette from depth 2, so the 4-vertex paths take it: baked and BVH pipelines share one path loop
         // (shaders/integrator.wgsl) and one roulette rule, so they agree sample by sample with it too.
         let settings = Settings { mode, max_depth: 4, rr_depth: 2, ..small(24, 24) };
-        let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::scene_data::SceneData::build(&scene)).unwrap();
+        let gs =
+            mislab::render::gpu_scene::GpuScene::upload(&ctx, mislab::render::scene_data::SceneData::build(&scene))
+                .unwrap();
         let mut r = mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), settings.clone()).unwrap();
         r.render(&ctx, 4).unwrap();
         let special = r.film(&ctx).unwrap();
@@ -133,7 +135,8 @@ fn specialised_and_generic_pipelines_agree() {
 fn large_requests_keep_every_sample() {
     let ctx = gpu();
     let scene = scene("cornell-box");
-    let gs = mislab::gpu_scene::GpuScene::upload(&ctx, mislab::scene_data::SceneData::build(&scene)).unwrap();
+    let gs = mislab::render::gpu_scene::GpuScene::upload(&ctx, mislab::render::scene_data::SceneData::build(&scene))
+        .unwrap();
     let mut r =
         mislab::render::Renderer::new(&ctx, &gs, scene.camera.clone(), Settings { mode: Mode::Path, ..small(8, 8) })
             .unwrap();

@@ -5,12 +5,12 @@
 
 mod common;
 use common::*;
-use mislab::chi2;
-use mislab::metrics::loglog_slope;
-use mislab::probe::{Probe, ProbeJob};
-use mislab::samplers::{self, *};
-use mislab::settings::{SamplerKind, Settings};
-use mislab::shaders;
+use mislab::render::samplers::{self, *};
+use mislab::render::settings::{SamplerKind, Settings};
+use mislab::render::shaders;
+use mislab::testkit::chi2;
+use mislab::testkit::metrics::loglog_slope;
+use mislab::testkit::probe::{Probe, ProbeJob};
 
 // ---------------------------------------------------------------------------------------------------------------
 // CPU: tables, constants, spp rules.
@@ -52,7 +52,7 @@ fn wgsl_constants_match_rust() {
         ("SALT_STRATIFIED_2D", SALT_STRATIFIED_2D),
     ];
     for (name, v) in pairs {
-        assert_eq!(value(name), *v, "WGSL {name} differs from src/samplers.rs");
+        assert_eq!(value(name), *v, "WGSL {name} differs from src/render/samplers.rs");
     }
     assert_eq!(sampler_data().len() as u32, SAMPLER_DATA_WORDS);
     // The 2D pairs of a vertex must fall inside one block of four (the padded Sobol sampler shuffles per block).
@@ -561,7 +561,8 @@ fn every_sampler_renders_the_furnace() {
     let ctx = gpu();
     let scene = scene("furnace");
     for kind in SamplerKind::ALL {
-        let settings = Settings { sampler: *kind, mode: mislab::settings::Mode::Path, max_depth: 4, ..small(16, 16) };
+        let settings =
+            Settings { sampler: *kind, mode: mislab::render::settings::Mode::Path, max_depth: 4, ..small(16, 16) };
         let film = render(&ctx, &scene, &settings, 16);
         assert_eq!(film.nonfinite_total, 0, "{kind}: NaN/Inf samples");
         let n = film.mean.len();
@@ -633,7 +634,7 @@ fn scratch(name: &str) -> std::path::PathBuf {
 /// blue-noise sampler's error has much less low-frequency power than high, independent sampling's is flat.
 #[test]
 fn sampler_figure_and_spectra() {
-    use mislab::sampler_figure::*;
+    use mislab::lab::sampler_figure::*;
     let (white, _) = error_spectrum(SamplerKind::Independent, 1);
     let (blue, _) = error_spectrum(SamplerKind::BlueNoise, 1);
     let (w, b) = (low_frequency_ratio(&white, SPECTRUM_SIZE), low_frequency_ratio(&blue, SPECTRUM_SIZE));
@@ -682,11 +683,12 @@ fn figure_samplers_follows_spp_and_seed_and_reports() {
 /// A reference's EXR header records its sample count and settings, and the pixels survive the round trip.
 #[test]
 fn reference_exr_records_spp_and_settings() {
-    use mislab::reference::*;
+    use mislab::lab::reference::*;
     let ctx = gpu();
     let scene = scene("veach-mis");
     let settings = reference_settings(&small(24, 16));
-    let (film, stats) = render_reference(&ctx, &scene, &settings, mislab::progressive::Budget::Samples(40), 0).unwrap();
+    let (film, stats) =
+        render_reference(&ctx, &scene, &settings, mislab::render::progressive::Budget::Samples(40), 0).unwrap();
     assert_eq!(stats.spp, 40);
     assert_eq!(film.spp(), 40);
     let dir = scratch("reference");
@@ -698,14 +700,17 @@ fn reference_exr_records_spp_and_settings() {
     assert_eq!(back.pixels, film.mean);
     assert_eq!(back.attributes.get("spp").map(String::as_str), Some("40"));
     let s: Settings = serde_json::from_str(&back.attributes["mislabSettings"]).unwrap();
-    assert_eq!((s.sampler, s.strategy, s.seed), (SamplerKind::Sobol, mislab::settings::Strategy::Mis, REFERENCE_SEED));
+    assert_eq!(
+        (s.sampler, s.strategy, s.seed),
+        (SamplerKind::Sobol, mislab::render::settings::Strategy::Mis, REFERENCE_SEED)
+    );
     assert_eq!(back.attributes.get("scene").map(String::as_str), Some("veach-mis"));
 }
 
 #[derive(clap::Parser)]
 struct BenchCli {
     #[command(flatten)]
-    args: mislab::bench::BenchArgs,
+    args: mislab::lab::bench::BenchArgs,
 }
 
 /// `mislab bench` from flags: every configuration × spp × seed is a row with the columns; JSON, summary
@@ -733,7 +738,7 @@ fn bench_end_to_end_from_flags() {
         "--out",
         &out,
     ]);
-    mislab::bench::run(&cli.args).unwrap();
+    mislab::lab::bench::run(&cli.args).unwrap();
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -795,13 +800,13 @@ fn bench_end_to_end_from_flags() {
         let args = ["bench", "veach-mis", "--width", "24", "--height", "16", "--spp", "2", "--seeds", "1"];
         BenchCli::parse_from(args.into_iter().chain(["--ref", &r, "--ref-spp", "4096", "--out", out]))
     };
-    mislab::bench::run(&with_ref(&cached, &again).args).unwrap();
+    mislab::lab::bench::run(&with_ref(&cached, &again).args).unwrap();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("again/results.json")).unwrap()).unwrap();
     assert_eq!(json["groups"][0]["reference_spp"], 256, "the given file's spp, not --ref-spp");
     let png = dir.join("ref.png");
     image::RgbImage::new(24, 16).save(&png).unwrap();
-    let e = mislab::bench::run(&with_ref(&png, &again).args).unwrap_err();
+    let e = mislab::lab::bench::run(&with_ref(&png, &again).args).unwrap_err();
     assert!(e.contains("not an OpenEXR file"), "{e}");
 }
 
@@ -818,7 +823,7 @@ fn bench_from_toml() {
     let out = dir.join("out").to_string_lossy().into_owned();
     let cfg = dir.join("bench.toml").to_string_lossy().into_owned();
     let cli = BenchCli::parse_from(["bench", "--config", &cfg, "--out", &out]);
-    mislab::bench::run(&cli.args).unwrap();
+    mislab::lab::bench::run(&cli.args).unwrap();
     let csv = std::fs::read_to_string(dir.join("out/results.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 2 * 2 + 2, "{csv}");
     assert!(csv.contains("heuristics,balance") && csv.contains("cornell path,sobol"));
@@ -843,6 +848,6 @@ fn lecture_suite_end_to_end() {
         .chain(["--out".into(), out.clone()])
         .collect();
     let cli = BenchCli::parse_from(args);
-    mislab::bench::run(&cli.args).unwrap();
+    mislab::lab::bench::run(&cli.args).unwrap();
     assert!(std::path::Path::new(&out).join("results.csv").exists());
 }

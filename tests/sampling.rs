@@ -2,18 +2,18 @@
 //! (evaluated on the device over the cells' quadrature points), with the pdf's integral; solid-angle sampling of
 //! triangles and rectangles against area sampling and Lambert's polygon formula; the f32 precision of the spherical
 //! warps against f64 references (which sets the fallback thresholds in lights.wgsl). The harness is
-//! `mislab::chi2`; the tables in docs/sampling.md come from `cargo test --release --test sampling -- --nocapture`.
+//! `mislab::testkit::chi2`; the tables in docs/sampling.md come from `cargo test --release --test sampling -- --nocapture`.
 //!
 //! All chi-square tests of this file form one family at α = 0.01 (Šidák-corrected per test). A missing GPU adapter
 //! fails every test.
 
 use glam::{DVec3, Vec3};
-use mislab::chi2::{self, Chi2Options, Chi2Report, Chi2Test, Equirect, PlaneWindow, Quadrature, SphereCap};
+use mislab::gpu::types::*;
 use mislab::gpu::GpuContext;
-use mislab::gpu_types::*;
+use mislab::render::settings::{EnvSampling, LightSampling, LightSelect};
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{EnvMap, Environment, Material, Mesh, PunctualLight, Quad, Scene, Sphere};
-use mislab::settings::{EnvSampling, LightSampling, LightSelect};
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
+use mislab::testkit::chi2::{self, Chi2Options, Chi2Report, Chi2Test, Equirect, PlaneWindow, Quadrature, SphereCap};
 use std::f64::consts::PI;
 use std::sync::{Mutex, OnceLock};
 use wgpu::util::DeviceExt;
@@ -241,7 +241,7 @@ struct ProbeJob {
 /// The probe module: the render module's files without the integrator, plus the probe kernels.
 fn probe_source() -> String {
     let files: Vec<&str> = mislab::render::RENDER_FILES.iter().copied().filter(|f| *f != "integrator.wgsl").collect();
-    mislab::shaders::compose(&files, PROBE_WGSL)
+    mislab::render::shaders::compose(&files, PROBE_WGSL)
 }
 
 /// Scenes the probes bind as group 0.
@@ -292,15 +292,17 @@ impl Harness {
             .expect("the sampling tests need a Vulkan adapter (install mesa-vulkan-drivers for lavapipe)");
         let device = &ctx.device;
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
-        let scene_entries: Vec<_> =
-            mislab::bindings::SCENE.iter().map(|b| mislab::bindings::layout_entry(&b.binding)).collect();
+        let scene_entries: Vec<_> = mislab::render::bindings::SCENE
+            .iter()
+            .map(|b| mislab::render::bindings::layout_entry(&b.binding))
+            .collect();
         let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe scene"),
             entries: &scene_entries,
         });
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe frame"),
-            entries: &[mislab::bindings::layout_entry(&mislab::bindings::FRAME[0])],
+            entries: &[mislab::render::bindings::layout_entry(&mislab::render::bindings::FRAME[0])],
         });
         let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe io"),
@@ -316,11 +318,18 @@ impl Harness {
             immediate_size: 0,
         });
         let source = probe_source();
-        let sample =
-            mislab::shaders::compute_pipeline(device, "probe_sample", &source, "probe_sample", &[], Some(&layout))
-                .unwrap();
+        let sample = mislab::render::shaders::compute_pipeline(
+            device,
+            "probe_sample",
+            &source,
+            "probe_sample",
+            &[],
+            Some(&layout),
+        )
+        .unwrap();
         let pdf =
-            mislab::shaders::compute_pipeline(device, "probe_pdf", &source, "probe_pdf", &[], Some(&layout)).unwrap();
+            mislab::render::shaders::compute_pipeline(device, "probe_pdf", &source, "probe_pdf", &[], Some(&layout))
+                .unwrap();
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("probe params"),
             size: std::mem::size_of::<GpuFrameParams>() as u64,
@@ -1633,7 +1642,7 @@ fn chi2_light_tree_selection() {
         let (pv, nv) = (Vec3::from(*p), Vec3::from(*n));
         let worst_cpu = (0..bounded)
             .map(|i| {
-                let cpu = mislab::light_tree::pmf(&d.light_tree, d.lights[i].tree_trail, pv, nv) as f64 / 3.0;
+                let cpu = mislab::accel::light_tree::pmf(&d.light_tree, d.lights[i].tree_trail, pv, nv) as f64 / 3.0;
                 (pmf[i] - cpu).abs() / cpu.max(1e-12)
             })
             .fold(0.0, f64::max);
@@ -1838,7 +1847,7 @@ fn barycentrics(a: DVec3, b: DVec3, c: DVec3, w: DVec3) -> [f64; 2] {
 
 /// A WGSL `const NAME: f32 = value;` of lights.wgsl.
 fn wgsl_const(name: &str) -> f64 {
-    let src = mislab::shaders::file("lights.wgsl");
+    let src = mislab::render::shaders::file("lights.wgsl");
     let line = src
         .lines()
         .find(|l| l.trim_start().starts_with(&format!("const {name}:")))

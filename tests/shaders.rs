@@ -4,7 +4,7 @@
 #[test]
 fn render_module_validates() {
     let src = mislab::render::render_source();
-    if let Err(e) = mislab::shaders::validate(&src) {
+    if let Err(e) = mislab::render::shaders::validate(&src) {
         panic!("render module:\n{e}");
     }
 }
@@ -16,8 +16,8 @@ fn every_file_is_embedded_and_nonempty() {
         let name = entry.unwrap().file_name().into_string().unwrap();
         if name.ends_with(".wgsl") {
             assert!(
-                mislab::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty()),
-                "{name} is not embedded in src/shaders.rs"
+                mislab::render::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty()),
+                "{name} is not embedded in src/render/shaders.rs"
             );
         }
     }
@@ -27,8 +27,8 @@ fn every_file_is_embedded_and_nonempty() {
 /// pipeline key of its own (a cache must never hand one scene's baked pipeline to another).
 #[test]
 fn baked_scene_modules_validate_and_have_their_own_keys() {
-    use mislab::features::Features;
-    use mislab::scene_data::SceneData;
+    use mislab::render::features::Features;
+    use mislab::render::scene_data::SceneData;
     let mut keys = std::collections::HashSet::new();
     for name in ["veach-mis", "cornell-box", "furnace", "area-vs-cosine"] {
         let scene = mislab::scene::load(name, &Default::default()).unwrap();
@@ -37,7 +37,7 @@ fn baked_scene_modules_validate_and_have_their_own_keys() {
         assert!(f.flat.is_some() && f.baked != 0, "{name} should be baked");
         let src = mislab::render::render_source_for(&data);
         assert!(src.contains("tri_hit(") || data.tri_shading.is_empty(), "{name}: no unrolled triangle tests");
-        if let Err(e) = mislab::shaders::validate(&src) {
+        if let Err(e) = mislab::render::shaders::validate(&src) {
             panic!("{name}: baked module:\n{e}");
         }
         assert!(keys.insert(f.baked), "{name} shares a baked key with another scene");
@@ -92,7 +92,7 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
     // Nothing else names a kind or switches on one: each kind's tag appears in the shaders only in its cases (and
     // its definition), and `.kind` is read only by the dispatchers.
     let mut all = String::new();
-    for (name, _) in mislab::shaders::FILES {
+    for (name, _) in mislab::render::shaders::FILES {
         if *name != "common.wgsl" {
             all += &code(name);
         }
@@ -101,8 +101,8 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         assert_eq!(count(&all, &format!("LIGHT_{k}")), ops.len(), "LIGHT_{k} is named outside the light dispatchers");
     }
     assert_eq!(count(&all, ".kind"), ops.len(), "something besides the dispatchers reads a light's kind");
-    // Rust: the tag is defined in gpu_types.rs, turned into table entries in scene_data.rs and into HAS_* flags in
-    // features.rs, and named in no other file of src/.
+    // Rust: the tag is defined in gpu/types.rs, turned into table entries in render/scene_data.rs and into HAS_*
+    // flags in render/features.rs, and named in no other file of src/.
     let mut files = Vec::new();
     let mut stack = vec![dir.join("src")];
     while let Some(d) = stack.pop() {
@@ -117,10 +117,10 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
     }
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
-        let name = f.file_name().unwrap().to_str().unwrap();
+        let name = f.strip_prefix(dir.join("src")).unwrap().to_str().unwrap().replace('\\', "/");
         if kinds.iter().any(|k| text.contains(&format!("LIGHT_{k}"))) {
             assert!(
-                ["gpu_types.rs", "scene_data.rs", "features.rs"].contains(&name),
+                ["gpu/types.rs", "render/scene_data.rs", "render/features.rs"].contains(&name.as_str()),
                 "{} names a light kind: adding one would have to touch it too",
                 f.display()
             );

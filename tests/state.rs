@@ -2,8 +2,8 @@
 //! uninterrupted render bit for bit; parts merged in any order match the single render within 1e-5 relative;
 //! bad state files and foreign parts are refused by name with exit code 2. The GPU tests run the real binary.
 
-use mislab::gpu_types::GpuAccum;
-use mislab::settings::Settings;
+use mislab::gpu::types::GpuAccum;
+use mislab::render::settings::Settings;
 use mislab::state::merge::{check_parts, merge_accum, Part};
 use mislab::state::session::part_range;
 use mislab::state::{RenderState, StateHeader};
@@ -166,10 +166,10 @@ fn four_parts_merged_in_shuffled_order_match_the_single_render() {
     assert!(worst <= 1e-5, "merged parts differ from the single render by {worst:e} relative");
     eprintln!("worst relative difference merged vs single: {worst:e}");
     // The merged EXR is a reference: its header says spp.
-    let r = mislab::reference::read_exr(&d.join("m1.exr")).unwrap();
+    let r = mislab::lab::reference::read_exr(&d.join("m1.exr")).unwrap();
     assert_eq!(r.attributes.get("spp").map(String::as_str), Some("60"));
     // `mislab bench --ref` reads the merged state as a reference too.
-    let r = mislab::reference::read_exr(&d.join("m1.state")).unwrap();
+    let r = mislab::lab::reference::read_exr(&d.join("m1.state")).unwrap();
     assert_eq!(r.pixels, m1.accum.iter().map(|a| a.mean).collect::<Vec<_>>());
     assert_eq!(r.attributes.get("spp").map(String::as_str), Some("60"));
     // Status of the directory: complete; then with a part gone, incomplete and naming it.
@@ -363,7 +363,7 @@ fn reference_parts_merge_to_the_whole_reference() {
     let part = |k: u32| d.join(format!("r{k}.state"));
     run_ok(bin().arg("merge").args([part(1), part(2), part(0)]).arg("-o").arg(d.join("merged.exr")));
     let whole = RenderState::read(&d.join("whole.state")).unwrap();
-    let merged = mislab::reference::read_exr(&d.join("merged.exr")).unwrap();
+    let merged = mislab::lab::reference::read_exr(&d.join("merged.exr")).unwrap();
     assert_eq!(merged.attributes.get("spp").map(String::as_str), Some("16"));
     for (a, b) in whole.accum.iter().zip(&merged.pixels) {
         for c in 0..3 {

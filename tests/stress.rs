@@ -6,9 +6,9 @@ mod common;
 #[test]
 fn every_stress_case_is_finite_and_right() {
     let ctx = common::gpu();
-    let outcomes = mislab::stress::run(&ctx, None, |o| eprintln!("{}", mislab::stress::progress_line(o)))
+    let outcomes = mislab::lab::stress::run(&ctx, None, |o| eprintln!("{}", mislab::lab::stress::progress_line(o)))
         .unwrap_or_else(|e| panic!("the stress suite could not run: {e}"));
-    eprintln!("{}", mislab::stress::table(&outcomes));
+    eprintln!("{}", mislab::lab::stress::table(&outcomes));
     assert!(outcomes.len() >= 40, "the issue asks for at least 40 stress configurations, found {}", outcomes.len());
     let analytic = outcomes.iter().filter(|o| o.expected.is_some()).count();
     assert!(analytic >= 30, "at least 30 cases should check a known mean, found {analytic}");

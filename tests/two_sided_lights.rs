@@ -5,9 +5,9 @@
 
 mod common;
 
+use mislab::render::scene_data::SceneData;
+use mislab::render::settings::{LightSampling, Mode, Settings, Strategy};
 use mislab::scene::{self, LoadOptions, Scene};
-use mislab::scene_data::SceneData;
-use mislab::settings::{LightSampling, Mode, Settings, Strategy};
 use std::f64::consts::PI;
 
 const ALBEDO: f64 = 0.5;

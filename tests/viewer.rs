@@ -5,10 +5,10 @@
 
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use mislab::film::{linear_to_srgb, tonemap, Tonemap};
+use mislab::gpu::types::GpuAccum;
 use mislab::gpu::GpuContext;
-use mislab::gpu_types::GpuAccum;
-use mislab::settings::*;
+use mislab::render::film::{linear_to_srgb, tonemap, Tonemap};
+use mislab::render::settings::*;
 use mislab::viewer::app::{settings_grid, Viewer};
 use mislab::viewer::display::{self, DisplayInputs, DisplayParams, DisplayPass, View};
 use mislab::viewer::engine::{Command, Shared};
@@ -372,7 +372,7 @@ fn display_pass_matches_its_cpu_twin() {
 #[test]
 fn display_layouts_match() {
     let src = display::display_source();
-    let m = mislab::shaders::validate(&src).unwrap_or_else(|e| panic!("display module:\n{e}"));
+    let m = mislab::render::shaders::validate(&src).unwrap_or_else(|e| panic!("display module:\n{e}"));
     let layout = |name: &str| -> (u32, Vec<(String, u32)>) {
         for (_, ty) in m.types.iter() {
             if ty.name.as_deref() == Some(name) {

@@ -2,7 +2,7 @@
 //! ../shared/testdata) and their environment variables.
 
 use mislab::gpu::GpuContext;
-use mislab::progressive::{self, Budget, RenderStats};
+use mislab::render::progressive::{self, Budget, RenderStats};
 use mislab::render::Renderer;
 use mislab::scene::{self, envmap, Environment, LoadOptions, Scene};
 use std::sync::atomic::AtomicBool;

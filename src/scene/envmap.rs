@@ -31,11 +31,11 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
         }
     };
     // A regular file only (a FIFO would block, /dev/zero never ends), and within the documented size limit.
-    let (file, len) = crate::input_file::open_regular(path).map_err(|m| match m.as_str() {
+    let (file, len) = crate::io::input_file::open_regular(path).map_err(|m| match m.as_str() {
         "no such file" => err("environment map not found".into()),
         _ => err(format!("environment map {m}")),
     })?;
-    let limit = crate::input_file::MAX_ENVMAP_BYTES;
+    let limit = crate::io::input_file::MAX_ENVMAP_BYTES;
     if len > limit {
         return Err(err(format!("environment map is {len} bytes, over the limit of {limit} bytes")));
     }

@@ -463,7 +463,7 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         return Err(SceneError::new(path, format!("no such file, and not a built-in scene (built-ins: {names})")));
     }
     // Anything but a regular file (a FIFO would block, /dev/zero never ends) is refused before a loader opens it.
-    crate::input_file::open_regular(path).map_err(|m| SceneError::new(path, m))?;
+    crate::io::input_file::open_regular(path).map_err(|m| SceneError::new(path, m))?;
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     if ext.is_empty() {
         return Err(SceneError::new(
@@ -480,7 +480,7 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
             path,
             format!(
                 "unknown scene format '.{}' (expected .gltf, .glb, .toml, .pbrt or Mitsuba .xml)",
-                crate::input_file::clip(&ext, 20)
+                crate::io::input_file::clip(&ext, 20)
             ),
         )),
     });

@@ -1,7 +1,7 @@
 //! PLY meshes (ASCII, binary little- and big-endian; gzip'd `.ply.gz`): vertex positions, normals and UVs, and
 //! polygon faces fanned into triangles. Elements and properties we do not use are read past.
 
-use crate::input_file::clip;
+use crate::io::input_file::clip;
 use glam::{Vec2, Vec3};
 
 /// A PLY mesh in its own (object) space.

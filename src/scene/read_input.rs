@@ -9,7 +9,7 @@ use std::path::Path;
 /// `scene.pbrt: line 12`) is added to the error message.
 pub fn read_bytes(path: &Path, referenced_by: &str) -> Result<Vec<u8>, SceneError> {
     let by = if referenced_by.is_empty() { String::new() } else { format!(" (referenced by {referenced_by})") };
-    crate::input_file::read_bounded(path, crate::input_file::MAX_GLTF_BYTES).map_err(|e| {
+    crate::io::input_file::read_bounded(path, crate::io::input_file::MAX_GLTF_BYTES).map_err(|e| {
         let e = if e == "no such file" { "file not found".to_string() } else { e };
         SceneError::new(path, format!("{e}{by}"))
     })

@@ -18,10 +18,10 @@ pub struct SceneSpec {
     #[arg(long)]
     pub env: Option<PathBuf>,
     /// Scale of the --env map (finite, 0 to 1e30).
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = crate::cli_values::env_scale)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = crate::io::cli_values::env_scale)]
     pub env_scale: f32,
     /// Rotation of the --env map about +Y, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::cli_values::degrees)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::io::cli_values::degrees)]
     pub env_rotation: f32,
     /// Let glTF buffer and image URIs be absolute paths or lead outside the glTF file's directory (by `..` or
     /// a symbolic link); without it such a URI is an error.

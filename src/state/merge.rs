@@ -3,8 +3,8 @@
 //! foreign parts by name; and `mislab merge --status DIR`: how far a split render is.
 
 use super::{RenderState, StateHeader};
-use crate::film::Tonemap;
-use crate::gpu_types::GpuAccum;
+use crate::gpu::types::GpuAccum;
+use crate::render::film::Tonemap;
 use std::path::{Path, PathBuf};
 
 /// `mislab merge` flags.
@@ -208,7 +208,7 @@ pub fn run(args: &MergeArgs) -> Result<u8, String> {
     merged.write(&state_path)?;
     let film = merged.film();
     if ext == "exr" {
-        crate::exr_image::write(&output, film.pixels(), &exr_attributes(&merged.header, parts.len()))?;
+        crate::io::exr_image::write(&output, film.pixels(), &exr_attributes(&merged.header, parts.len()))?;
     } else {
         film.save(&output, args.exposure, args.tonemap)?;
     }

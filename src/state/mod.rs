@@ -11,11 +11,11 @@
 pub mod merge;
 pub mod session;
 
-use crate::film::Film;
-use crate::gpu_types::GpuAccum;
+use crate::gpu::types::GpuAccum;
+use crate::render::film::Film;
+use crate::render::scene_data::SceneData;
+use crate::render::settings::Settings;
 use crate::scene::Camera;
-use crate::scene_data::SceneData;
-use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -191,13 +191,13 @@ impl RenderState {
     }
 
     /// The mean image with a reference EXR's attributes (`mislab bench --ref` reads states through this).
-    pub fn reference_image(&self) -> crate::exr_image::ReferenceImage {
+    pub fn reference_image(&self) -> crate::io::exr_image::ReferenceImage {
         let s = &self.header.settings;
         let attributes = merge::exr_attributes(&self.header, 0)
             .into_iter()
             .chain([("stateSamples".to_string(), format!("{}..{}", self.header.range.0, self.header.next))])
             .collect();
-        crate::exr_image::ReferenceImage {
+        crate::io::exr_image::ReferenceImage {
             width: s.width,
             height: s.height,
             pixels: self.accum.iter().map(|a| a.mean).collect(),
@@ -299,7 +299,7 @@ impl RenderState {
     /// Writes the state atomically (temporary file, fsync, rename).
     pub fn write(&self, path: &Path) -> Result<(), String> {
         let bytes = self.to_bytes();
-        crate::output_file::replace_atomically(path, |tmp| std::fs::write(tmp, &bytes).map_err(|e| e.to_string()))
+        crate::io::output_file::replace_atomically(path, |tmp| std::fs::write(tmp, &bytes).map_err(|e| e.to_string()))
             .map_err(|e| format!("{}: could not write the state file: {e}", path.display()))
     }
 }

@@ -2,11 +2,11 @@
 //! indices this run renders, restoring a saved state into the renderer, and writing checkpoints while it renders.
 
 use super::{RenderState, StateHeader};
+use crate::gpu::types::GpuAccum;
 use crate::gpu::GpuContext;
-use crate::gpu_types::GpuAccum;
-use crate::progressive::{RenderStats, TARGET_SUBMIT_SECONDS};
+use crate::render::progressive::{RenderStats, TARGET_SUBMIT_SECONDS};
+use crate::render::settings::Settings;
 use crate::render::Renderer;
-use crate::settings::Settings;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};

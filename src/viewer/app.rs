@@ -5,8 +5,8 @@
 use super::camera::Orbit;
 use super::display::{self, View, TONEMAPS};
 use super::engine::{Command, DisplayOptions, EngineHandle, Frame, Side, SideStats};
-use crate::film::Tonemap;
-use crate::settings::*;
+use crate::render::film::Tonemap;
+use crate::render::settings::*;
 use eframe::egui;
 use egui::{Color32, Pos2, Rect, Sense, Vec2};
 use std::collections::VecDeque;

@@ -2,9 +2,9 @@
 //! image the window shows, plus per-workgroup statistics sums; the false-colour scale's CPU twin for the
 //! legend.
 
-use crate::film::Tonemap;
+use crate::gpu::types::GpuAccum;
 use crate::gpu::{GpuContext, GpuError};
-use crate::gpu_types::GpuAccum;
+use crate::render::film::Tonemap;
 use bytemuck::{Pod, Zeroable};
 
 /// WGSL files of the display entry point, in order.
@@ -12,7 +12,7 @@ pub const DISPLAY_FILES: &[&str] = &["display.wgsl"];
 
 /// The composed display module.
 pub fn display_source() -> String {
-    crate::shaders::compose(DISPLAY_FILES, "")
+    crate::render::shaders::compose(DISPLAY_FILES, "")
 }
 
 /// What the image area shows.
@@ -236,7 +236,7 @@ impl DisplayPass {
         let pipelines = View::ALL
             .iter()
             .map(|v| {
-                crate::shaders::compute_pipeline(
+                crate::render::shaders::compute_pipeline(
                     &device,
                     "display",
                     &display_source(),
@@ -246,7 +246,7 @@ impl DisplayPass {
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let stats_pipeline = crate::shaders::compute_pipeline(
+        let stats_pipeline = crate::render::shaders::compute_pipeline(
             &device,
             "display stats",
             &display_source(),

@@ -8,10 +8,10 @@ pub mod camera;
 pub mod display;
 pub mod engine;
 
-use crate::film::Tonemap;
 use crate::gpu::GpuContext;
+use crate::render::film::Tonemap;
+use crate::render::settings::{Settings, Strategy};
 use crate::scene::{Scene, SceneSpec};
-use crate::settings::{Settings, Strategy};
 use app::Viewer;
 use display::View;
 use eframe::{egui, egui_wgpu};

@@ -1,12 +1,12 @@
 //! Helpers shared by the GPU integration tests. A missing adapter is a test FAILURE with a clear message.
 #![allow(dead_code)]
 
-use mislab::film::Film;
 use mislab::gpu::GpuContext;
+use mislab::render::film::Film;
+use mislab::render::settings::Settings;
 use mislab::render::Renderer;
+use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{self, LoadOptions, Scene};
-use mislab::settings::Settings;
-use mislab::{gpu_scene::GpuScene, scene_data::SceneData};
 
 /// The GPU context, or a panic that says how to get one.
 pub fn gpu() -> GpuContext {

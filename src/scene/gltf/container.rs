@@ -126,7 +126,7 @@ fn check_index_range(v: &json::Value, at: &mut String) -> Res<()> {
                 items.iter().enumerate().try_for_each(|(i, item)| numbers(item, &format!("{at}[{i}]")))
             }
             json::Value::Object(map) => map.iter().try_for_each(|(k, item)| match item {
-                json::Value::Number(_) => numbers(item, &format!("{at}.{}", crate::input_file::clip(k, 40))),
+                json::Value::Number(_) => numbers(item, &format!("{at}.{}", crate::io::input_file::clip(k, 40))),
                 _ => Ok(()),
             }),
             _ => Ok(()),
@@ -142,7 +142,7 @@ fn check_index_range(v: &json::Value, at: &mut String) -> Res<()> {
                 if !at.is_empty() {
                     at.push('.');
                 }
-                at.push_str(&crate::input_file::clip(k, 40));
+                at.push_str(&crate::io::input_file::clip(k, 40));
                 if INDEX_KEYS.contains(&k.as_str()) {
                     numbers(item, at)?;
                 }
@@ -202,14 +202,14 @@ pub(super) struct Uris<'p> {
 
 /// A URI as echoed in messages: cut (a hostile file can hold megabytes in one), never file content.
 fn shown(uri: &str) -> String {
-    crate::input_file::clip(uri, 80)
+    crate::io::input_file::clip(uri, 80)
 }
 
 /// Reads every buffer (GLB chunk, external file or data URI) and checks it against its declared byteLength.
 /// An external file is read only up to the declared length (itself checked against the limit first), so a
 /// buffer naming a huge or endless file never reads more than it declared.
 pub(super) fn load_buffers(root: &json::Root, bin: Option<&[u8]>, is_glb: bool, uris: Uris) -> Res<Vec<Vec<u8>>> {
-    use crate::input_file::{read_prefix, MAX_GLTF_BYTES};
+    use crate::io::input_file::{read_prefix, MAX_GLTF_BYTES};
     let mut out = Vec::with_capacity(root.buffers.len());
     for (i, buffer) in root.buffers.iter().enumerate() {
         let what = format!("buffer {i}{}", quoted(&buffer.name));
@@ -257,7 +257,7 @@ pub(super) fn fetch_uri(uris: Uris, uri: &str, read: impl Fn(&Path) -> Res<Vec<u
         }
         p => p,
     };
-    read(&path).map_err(|m| format!("cannot read '{}': {m}", crate::input_file::clip_path(&path, 160)))
+    read(&path).map_err(|m| format!("cannot read '{}': {m}", crate::io::input_file::clip_path(&path, 160)))
 }
 
 /// The file a relative URI names, refusing (unless allowed) absolute paths and paths that climb out of the

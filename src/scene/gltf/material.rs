@@ -149,9 +149,9 @@ impl Loader<'_> {
             .ok_or_else(|| format!("{label}: image {index} does not exist (the file has {count} images)"))?;
         let what = format!("image {index} ({})", image_name(root, index));
         let bytes = match (&image.uri, image.buffer_view) {
-            (Some(uri), _) => {
-                fetch_uri(self.uris(), uri, |p| crate::input_file::read_bounded(p, crate::input_file::MAX_IMAGE_BYTES))
-            }
+            (Some(uri), _) => fetch_uri(self.uris(), uri, |p| {
+                crate::io::input_file::read_bounded(p, crate::io::input_file::MAX_IMAGE_BYTES)
+            }),
             (None, Some(view)) => self.view(view.value()).map(|(bytes, _)| bytes.to_vec()),
             (None, None) => Err("has neither a uri nor a bufferView".into()),
         }

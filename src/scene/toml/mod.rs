@@ -20,13 +20,13 @@ use material::{material, MaterialDef};
 /// Loads a TOML scene. Relative paths inside it (environment maps, includes) are resolved against its directory.
 /// Errors name the file and, where the problem is in the file, its line.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
-    let text = crate::input_file::read_bounded_text(path, crate::input_file::MAX_TOML_BYTES)
+    let text = crate::io::input_file::read_bounded_text(path, crate::io::input_file::MAX_TOML_BYTES)
         .map_err(|m| SceneError::new(path, m))?;
     let ctx = Ctx { path, text: &text, dir: path.parent().unwrap_or(Path::new("")).to_path_buf() };
     let file: FileDef = ::toml::from_str(&text).map_err(|e| {
         let at = e.span().map(|s| ctx.position(s.start)).unwrap_or_default();
         // toml's messages can span lines ("invalid table header\nexpected `.`, `]`"); keep ours on one.
-        let message = crate::input_file::clip_quoted(&e.message().trim_end().replace('\n', "; "), 80);
+        let message = crate::io::input_file::clip_quoted(&e.message().trim_end().replace('\n', "; "), 80);
         SceneError::new(path, format!("{at}{message}"))
     })?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
@@ -541,7 +541,7 @@ fn include(
 
     let path = ctx.resolve(&d.gltf);
     // The same check every input gets (a FIFO, a directory or /dev/zero is named as what it is).
-    if let Err(m) = crate::input_file::open_regular(&path) {
+    if let Err(m) = crate::io::input_file::open_regular(&path) {
         let m = if m == "no such file" { "not found".to_string() } else { m };
         return Err(e(&format!("glTF file {}: {m}", path.display())));
     }

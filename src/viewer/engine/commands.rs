@@ -4,9 +4,9 @@
 use super::display;
 use super::side::SideState;
 use super::{scene_centre, Command, Engine};
+use crate::render::settings::Settings;
+use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{self, Environment, LoadOptions, Scene};
-use crate::settings::Settings;
-use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::sync::Arc;
 
 impl Engine {

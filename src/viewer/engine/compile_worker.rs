@@ -4,12 +4,12 @@
 
 use super::side::SideState;
 use super::{Engine, PipelineState};
-use crate::features::PipelineKey;
 use crate::gpu::GpuContext;
+use crate::render::features::PipelineKey;
+use crate::render::settings::{Settings, Strategy};
 use crate::render::Renderer;
+use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{Camera, Scene};
-use crate::settings::{Settings, Strategy};
-use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -100,8 +100,14 @@ fn compile_worker(
             }
         }
         let constants = job.key.constants();
-        let result =
-            crate::shaders::compute_pipeline(&device, "render", &job.source, "render_main", &constants, Some(&layout));
+        let result = crate::render::shaders::compute_pipeline(
+            &device,
+            "render",
+            &job.source,
+            "render_main",
+            &constants,
+            Some(&layout),
+        );
         if done.send((job.key, result, t.elapsed().as_secs_f64())).is_err() {
             return;
         }

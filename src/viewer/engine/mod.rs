@@ -13,14 +13,14 @@
 //! tuning constants, the engine's state and its loop.
 
 use super::display::{self, DisplayPass, ImageStats};
-use crate::features::PipelineKey;
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
-use crate::gpu_timer::GpuTimer;
-use crate::pipeline_cache::PipelineCache;
+use crate::render::features::PipelineKey;
+use crate::render::pipeline_cache::PipelineCache;
+use crate::render::settings::Settings;
 use crate::render::Renderer;
+use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{Camera, Scene};
-use crate::settings::Settings;
-use crate::{gpu_scene::GpuScene, scene_data::SceneData};
 use compile_worker::{CompileJob, Wanted};
 use side::SideState;
 use std::collections::{HashMap, HashSet};

@@ -5,10 +5,10 @@
 use super::display::ImageStats;
 use super::display::View;
 use super::Engine;
-use crate::film::Tonemap;
 use crate::gpu::GpuContext;
+use crate::render::film::Tonemap;
+use crate::render::settings::Settings;
 use crate::scene::{Camera, Scene};
-use crate::settings::Settings;
 use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex, MutexGuard};

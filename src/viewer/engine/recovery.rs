@@ -4,9 +4,9 @@
 use super::display::DisplayPass;
 use super::side::SideState;
 use super::Engine;
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
-use crate::gpu_timer::GpuTimer;
-use crate::{gpu_scene::GpuScene, scene_data::SceneData};
+use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 

@@ -3,10 +3,10 @@
 
 use super::{PipelineState, PREVIEW_SCALE};
 use crate::gpu::GpuContext;
-use crate::gpu_scene::GpuScene;
+use crate::render::gpu_scene::GpuScene;
+use crate::render::settings::Settings;
 use crate::render::Renderer;
 use crate::scene::Camera;
-use crate::settings::Settings;
 use std::time::Instant;
 
 /// Per-side render state.

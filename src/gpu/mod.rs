@@ -1,0 +1,8 @@
+//! The device layer: the Vulkan context, the GPU timer and the structs the shaders share with Rust, byte for byte.
+//! Nothing here knows about scenes, estimators or pipelines.
+
+pub mod context;
+pub mod timer;
+pub mod types;
+
+pub use context::*;

@@ -1,0 +1,316 @@
+//! Baked geometry: a tiny scene's primitives written into the render shader as literals.
+//!
+//! For scenes of at most `FLAT_MAX_PRIMS` primitives (`Features::flat`) traversal is a generated, unrolled list of
+//! intersection tests with the geometry as constants. Why it pays on lavapipe: the driver runs shader code under
+//! SIMD masks, so the cost of a trace is the length of its code, whatever the rays do; generated code can be
+//! shorter than any loop over buffers:
+//! - no loads (every storage-buffer read is a bounds-checked gather), and per-primitive invariants folded into
+//!   literals (a quad's normal and dual axes);
+//! - triangles of a mesh share vertices and edges, and the watertight test's per-ray work is per vertex (shear)
+//!   and per edge (edge function): each distinct vertex and edge is computed once per ray and shared by the
+//!   triangles around it — the same values, bit for bit, as testing each triangle alone (`tri_hit`).
+//!
+//! The storage buffers stay bound: shading (`surface_at`) reads them once per hit, and the generic pipeline (the
+//! viewer's) never calls the baked function.
+
+use crate::accel::convex_solids::convex_solids;
+use crate::gpu::types::*;
+use crate::render::scene_data::SceneData;
+use glam::Vec3;
+use std::collections::HashMap;
+use std::fmt::Write;
+
+/// Largest primitive count rendered without a BVH (`Features::flat`).
+pub const FLAT_MAX_PRIMS: usize = 32;
+
+/// (triangles, spheres, quads) of a scene small enough to test every primitive without a BVH.
+pub fn flat_counts(data: &SceneData) -> Option<(u32, u32, u32)> {
+    let n = (data.tri_shading.len(), data.spheres.len(), data.quads.len());
+    (n.0 + n.1 + n.2 <= FLAT_MAX_PRIMS).then_some((n.0 as u32, n.1 as u32, n.2 as u32))
+}
+
+/// A WGSL f32 literal that round-trips exactly (Rust's shortest representation, with the `f` suffix).
+fn lit(x: f32) -> String {
+    let s = format!("{x:?}");
+    if s.contains(['.', 'e', 'E']) {
+        format!("{s}f")
+    } else {
+        format!("{s}.0f")
+    }
+}
+
+fn vec3_lit(v: Vec3) -> String {
+    format!("vec3<f32>({}, {}, {})", lit(v.x), lit(v.y), lit(v.z))
+}
+
+/// Distinct vertices (by bit pattern) and undirected edges of the triangles, in first-use order.
+struct MeshTopology {
+    vertices: Vec<Vec3>,
+    /// Per triangle: its three vertex ids.
+    corners: Vec<[usize; 3]>,
+    /// Undirected edges (lower id first).
+    edges: Vec<(usize, usize)>,
+    edge_id: HashMap<(usize, usize), usize>,
+}
+
+impl MeshTopology {
+    fn of(tri_verts: &[[f32; 4]], n: usize) -> MeshTopology {
+        let mut t = MeshTopology { vertices: vec![], corners: vec![], edges: vec![], edge_id: HashMap::new() };
+        let mut vertex_id: HashMap<[u32; 3], usize> = HashMap::new();
+        for tri in 0..n {
+            let mut c = [0; 3];
+            for (k, id) in c.iter_mut().enumerate() {
+                let p = tri_verts[3 * tri + k];
+                let key = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+                *id = *vertex_id.entry(key).or_insert_with(|| {
+                    t.vertices.push(Vec3::new(p[0], p[1], p[2]));
+                    t.vertices.len() - 1
+                });
+            }
+            for (a, b) in [(c[2], c[1]), (c[0], c[2]), (c[1], c[0])] {
+                let key = (a.min(b), a.max(b));
+                if !t.edge_id.contains_key(&key) {
+                    t.edge_id.insert(key, t.edges.len());
+                    t.edges.push(key);
+                }
+            }
+            t.corners.push(c);
+        }
+        t
+    }
+
+    /// The WGSL expression for the edge function from vertex `a` to `b`: the shared edge value, negated when the
+    /// edge is stored the other way round (tri_edge(q, p) = −tri_edge(p, q) exactly: same canonical product).
+    fn edge_expr(&self, a: usize, b: usize) -> String {
+        let id = self.edge_id[&(a.min(b), a.max(b))];
+        if a < b {
+            format!("e{id}")
+        } else {
+            format!("-e{id}")
+        }
+    }
+}
+
+/// The member types of WGSL struct `name` in shaders/common.wgsl, in order, read from the shader source itself
+/// so that the literals written here can never fall out of step with the struct (whose layout matches its Rust
+/// twin: tests/layout.rs). One member per line, `name: type,` with an optional `//` comment, as common.wgsl
+/// writes them.
+fn wgsl_members(name: &str) -> Vec<String> {
+    let source = crate::render::shaders::file("common.wgsl");
+    let head = format!("struct {name} {{");
+    let body =
+        source.split_once(&head).map(|(_, rest)| rest).unwrap_or_else(|| panic!("no struct {name} in common.wgsl"));
+    let body = &body[..body.find('}').expect("struct body closed")];
+    body.lines()
+        .map(|l| l.split("//").next().unwrap_or("").trim())
+        .filter(|l| !l.is_empty())
+        .map(|l| l.split_once(':').expect("member `name: type,`").1.trim().trim_end_matches(',').trim().to_string())
+        .collect()
+}
+
+/// A WGSL constructor `name(...)` for one struct given as 4-byte words, or None if a float is not finite (WGSL
+/// has no literal for it; that table is then read from its buffer).
+fn struct_lit(name: &str, members: &[String], words: &[u32]) -> Option<String> {
+    let mut args = vec![];
+    let mut w = words.iter();
+    for ty in members {
+        let (n, scalar) = match ty.as_str() {
+            "f32" | "u32" => (1, ty.as_str()),
+            t => (t[3..4].parse::<usize>().ok()?, &t[5..8]),
+        };
+        let mut parts = vec![];
+        for _ in 0..n {
+            let x = *w.next()?;
+            parts.push(if scalar == "f32" {
+                let f = f32::from_bits(x);
+                if !f.is_finite() {
+                    return None;
+                }
+                lit(f)
+            } else {
+                format!("{x}u")
+            });
+        }
+        args.push(if n == 1 { parts.remove(0) } else { format!("{ty}({})", parts.join(", ")) });
+    }
+    Some(format!("{name}({})", args.join(", ")))
+}
+
+/// `fn accessor(i: u32) -> ty` returning entry i of `items` through a chain of selections (i out of range gives
+/// entry 0, as a clamped buffer read would give some entry), or reading `buffer_read` when an entry cannot be
+/// written as literals or there is none.
+fn accessor<T: bytemuck::Pod>(name: &str, ty: &str, members: &[String], items: &[T], buffer_read: &str) -> String {
+    let lits: Option<Vec<String>> =
+        items.iter().map(|x| struct_lit(ty, members, bytemuck::cast_slice(std::slice::from_ref(x)))).collect();
+    match lits {
+        Some(l) if !l.is_empty() => {
+            let mut f = format!("fn {name}(i: u32) -> {ty} {{\n    var x = {};\n", l[0]);
+            for (k, e) in l.iter().enumerate().skip(1) {
+                let _ = writeln!(f, "    if (i == {k}u) {{ x = {e}; }}");
+            }
+            f + "    return x;\n}\n"
+        }
+        _ => format!("fn {name}(i: u32) -> {ty} {{ return {buffer_read}; }}\n"),
+    }
+}
+
+/// The generated `scene_data.wgsl` and `baked_geometry.wgsl` for `data` (the shader files of those names are the
+/// stubs: they list the functions to define), or None when the scene is too large to bake (`Features::flat`).
+pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
+    flat_counts(data)?;
+    let mut out = String::from(
+        "// scene_data.wgsl, generated for one scene by src/render/baked.rs: its tables as literals.\n\n\
+         struct TriPositions {\n    v0: vec3<f32>,\n    v1: vec3<f32>,\n    v2: vec3<f32>,\n}\n\n",
+    );
+    let positions: Vec<[f32; 9]> = (0..data.tri_shading.len())
+        .map(|i| {
+            let v = |k: usize| data.tri_verts[3 * i + k];
+            let (a, b, c) = (v(0), v(1), v(2));
+            [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]]
+        })
+        .collect();
+    let tri_read = "TriPositions(tri_verts[3u * i].xyz, tri_verts[3u * i + 1u].xyz, tri_verts[3u * i + 2u].xyz)";
+    let vec3s = vec!["vec3<f32>".to_string(); 3];
+    out += &accessor("scene_tri_positions", "TriPositions", &vec3s, &positions, tri_read);
+    let shading = wgsl_members("TriShading");
+    out += &accessor("scene_tri_shading", "TriShading", &shading, &data.tri_shading, "tri_shading[i]");
+    out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "spheres[i]");
+    out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "quads[i]");
+    out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
+    out += &accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights, "lights[i]");
+    Some((out, baked_traverse_source(data)))
+}
+
+/// `baked_traverse` (closest hit) and `baked_occluded` (shadow rays) for `data`: every primitive's test with its
+/// data as literals.
+fn baked_traverse_source(data: &SceneData) -> String {
+    let mut out = String::from(
+        "// baked_geometry.wgsl, generated for one scene by src/render/baked.rs: every intersection test, unrolled.\n\n\
+         fn baked_traverse(r: TraceRay, start: Hit, skip: u32) -> Hit {\n    var hit = start;\n",
+    );
+    primitive_tests(data, &mut out, Query::Closest);
+    out += "    return hit;\n}\n\n\
+            fn baked_occluded(r: TraceRay, t_max: f32, skip: u32) -> bool {\n    var occluded = false;\n";
+    primitive_tests(data, &mut out, Query::Occluded);
+    out += "    return occluded;\n}\n";
+    out
+}
+
+/// What a generated traversal computes.
+#[derive(Clone, Copy, PartialEq)]
+enum Query {
+    /// The closest hit, into `hit`.
+    Closest,
+    /// Whether anything but `skip` blocks (0, t_max), into `occluded`.
+    Occluded,
+}
+
+/// Appends every primitive's test for `query`.
+fn primitive_tests(data: &SceneData, out: &mut String, query: Query) {
+    let mesh = MeshTopology::of(&data.tri_verts, data.tri_shading.len());
+    // Each vertex and edge is emitted just before the first triangle that needs it, so fewer values are live
+    // at once (spilling them costs more than recomputing would).
+    let (mut have_v, mut have_e) = (vec![false; mesh.vertices.len()], vec![false; mesh.edges.len()]);
+    // Shadow rays test closed convex meshes (not lights) as solids: a few plane clips instead of their triangles.
+    let solids = match query {
+        Query::Occluded => {
+            convex_solids(&data.tri_verts, data.tri_shading.len(), |t| data.tri_shading[t].light != INVALID)
+        }
+        Query::Closest => vec![],
+    };
+    let in_solid: Vec<bool> =
+        (0..mesh.corners.len()).map(|t| solids.iter().any(|s| s.triangles.contains(&t))).collect();
+    for (i, [a, b, c]) in mesh.corners.iter().enumerate() {
+        if in_solid[i] {
+            continue;
+        }
+        for v in [*a, *b, *c] {
+            if !std::mem::replace(&mut have_v[v], true) {
+                let _ = writeln!(out, "    let v{v} = tri_vertex(r, {});", vec3_lit(mesh.vertices[v]));
+            }
+        }
+        for (p, q) in [(*c, *b), (*a, *c), (*b, *a)] {
+            let id = mesh.edge_id[&(p.min(q), p.max(q))];
+            if !std::mem::replace(&mut have_e[id], true) {
+                let (x, y) = mesh.edges[id];
+                let _ = writeln!(out, "    let e{id} = tri_edge(v{x}.xy, v{y}.xy);");
+            }
+        }
+        let (u, v, w) = (mesh.edge_expr(*c, *b), mesh.edge_expr(*a, *c), mesh.edge_expr(*b, *a));
+        let call = format!("tri_hit({u}, {v}, {w}, v{a}.z, v{b}.z, v{c}.z, T_MAX)");
+        test_prim(out, query, make_prim(PRIM_TRIANGLE, i as u32), &call);
+    }
+    for s in &solids {
+        out.push_str("    {\n        var span = vec2<f32>(0.0, t_max);\n");
+        for (n, d) in &s.planes {
+            let _ = writeln!(
+                out,
+                "        span = clip_to_half_space(span, r, {}, {});",
+                vec3_lit(n.as_vec3()),
+                lit(*d as f32)
+            );
+        }
+        let _ =
+            writeln!(out, "        occluded = occluded | (span.x < span.y); // triangles {:?}\n    }}", s.triangles);
+    }
+    for (i, s) in data.spheres.iter().enumerate() {
+        let call = format!("intersect_sphere(r.o, r.d, {}, {}, T_MAX)", vec3_lit(s.center.into()), lit(s.radius));
+        test_prim(out, query, make_prim(PRIM_SPHERE, i as u32), &call);
+    }
+    for (i, q) in data.quads.iter().enumerate() {
+        let (eu, ev) = (Vec3::from(q.edge_u), Vec3::from(q.edge_v));
+        let n = eu.cross(ev);
+        let inv_nn = 1.0 / n.dot(n);
+        if !(inv_nn.is_finite() && n.is_finite()) {
+            continue; // degenerate: `intersect_quad` never reports a hit for it either
+        }
+        let call = format!(
+            "intersect_parallelogram(r.o, r.d, {}, {}, {}, {}, T_MAX)",
+            vec3_lit(q.corner.into()),
+            vec3_lit(n),
+            vec3_lit(ev.cross(n) * inv_nn),
+            vec3_lit(n.cross(eu) * inv_nn)
+        );
+        test_prim(out, query, make_prim(PRIM_QUAD, i as u32), &call);
+    }
+}
+
+/// One primitive's test: `call` (with T_MAX for the ray's current extent) yields the (t, b1, b2, hit) vector.
+/// Selects, no branches: lavapipe executes a branch's body whether or not a lane takes it, plus mask upkeep; and
+/// an early return for shadow rays saves nothing there.
+fn test_prim(out: &mut String, query: Query, prim: u32, call: &str) {
+    let _ = match query {
+        Query::Closest => writeln!(
+            out,
+            "    {{ let h = {}; let take = h.w != 0.0 && skip != {prim}u; \
+             hit = Hit(select(hit.t, h.x, take), select(hit.prim, {prim}u, take), select(hit.b1, h.y, take), select(hit.b2, h.z, take)); }}",
+            call.replace("T_MAX", "hit.t")
+        ),
+        Query::Occluded => {
+            writeln!(out, "    occluded = occluded | (({}).w != 0.0 && skip != {prim}u);", call.replace("T_MAX", "t_max"))
+        }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The member lists read from common.wgsl cover every 4-byte word of the Rust twins (no padding words
+    /// exist in these structs: their vec3s are followed by a scalar).
+    #[test]
+    fn member_lists_cover_the_rust_structs() {
+        let words = |ty: &str| -> usize {
+            wgsl_members(ty)
+                .iter()
+                .map(|m| if m == "f32" || m == "u32" { 1 } else { m[3..4].parse::<usize>().unwrap() })
+                .sum()
+        };
+        assert_eq!(4 * words("Material"), std::mem::size_of::<GpuMaterial>());
+        assert_eq!(4 * words("Light"), std::mem::size_of::<GpuLight>());
+        assert_eq!(4 * words("Sphere"), std::mem::size_of::<GpuSphere>());
+        assert_eq!(4 * words("Quad"), std::mem::size_of::<GpuQuad>());
+        assert_eq!(4 * words("TriShading"), std::mem::size_of::<GpuTriShading>());
+        assert_eq!(wgsl_members("Material")[3], "f32");
+    }
+}

@@ -1,0 +1,234 @@
+//! The render pipeline's bindings, declared once: group 0 (the scene's storage buffers) and group 1 (the per-render
+//! state). The WGSL declarations (`geometry_bindings.wgsl`, `shading_bindings.wgsl` in `shaders::compose`), the
+//! bind-group layouts, the scene's upload and its size check against the device limit all come from these tables;
+//! tests/layout.rs checks them against what naga reads in the composed module.
+
+use crate::accel::bvh::GpuBvhNode;
+use crate::accel::light_tree::GpuLightNode;
+use crate::gpu::types::*;
+use crate::render::scene_data::SceneData;
+
+/// How a shader reaches a binding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// `var<uniform>`.
+    Uniform,
+    /// `var<storage, read>`.
+    Read,
+    /// `var<storage, read_write>`.
+    ReadWrite,
+}
+
+/// One binding of the render pipeline.
+#[derive(Clone, Copy)]
+pub struct Binding {
+    /// Bind group.
+    pub group: u32,
+    /// Binding index within the group.
+    pub binding: u32,
+    /// The WGSL variable.
+    pub name: &'static str,
+    /// Its WGSL type.
+    pub wgsl_type: &'static str,
+    /// How the shader reaches it.
+    pub access: Access,
+    /// Bytes of one element (of the array, or of the uniform struct): the Rust side of the WGSL type.
+    pub element_size: usize,
+    /// What it holds, for people: error messages name the buffer by it.
+    pub label: &'static str,
+    /// A comment for the WGSL declaration ("" = none).
+    pub note: &'static str,
+}
+
+/// A group-0 binding and where its contents are in `SceneData`.
+#[derive(Clone, Copy)]
+pub struct SceneBinding {
+    /// The binding.
+    pub binding: Binding,
+    /// Its bytes in a flattened scene.
+    pub bytes: fn(&SceneData) -> &[u8],
+}
+
+const fn scene(
+    binding: u32,
+    name: &'static str,
+    wgsl_type: &'static str,
+    element_size: usize,
+    label: &'static str,
+) -> Binding {
+    Binding { group: 0, binding, name, wgsl_type, access: Access::Read, element_size, label, note: "" }
+}
+
+/// Bindings 0–4 of group 0 are the geometry (what BVH traversal reads; the probe kernels bind these alone).
+pub const GEOMETRY_BINDINGS: u32 = 5;
+
+/// Group 0: the scene, in binding order.
+pub const SCENE: [SceneBinding; 14] = [
+    SceneBinding {
+        binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
+        bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
+    },
+    SceneBinding {
+        binding: scene(1, "prim_refs", "array<u32>", 4, "primitive references"),
+        bytes: |d| bytemuck::cast_slice(&d.prim_refs),
+    },
+    SceneBinding {
+        binding: scene(2, "tri_verts", "array<vec4<f32>>", 16, "triangle vertices"),
+        bytes: |d| bytemuck::cast_slice(&d.tri_verts),
+    },
+    SceneBinding {
+        binding: scene(3, "spheres", "array<Sphere>", size_of::<GpuSphere>(), "spheres"),
+        bytes: |d| bytemuck::cast_slice(&d.spheres),
+    },
+    SceneBinding {
+        binding: scene(4, "quads", "array<Quad>", size_of::<GpuQuad>(), "quads"),
+        bytes: |d| bytemuck::cast_slice(&d.quads),
+    },
+    SceneBinding {
+        binding: scene(5, "tri_shading", "array<TriShading>", size_of::<GpuTriShading>(), "triangle shading data"),
+        bytes: |d| bytemuck::cast_slice(&d.tri_shading),
+    },
+    SceneBinding {
+        binding: scene(6, "materials", "array<Material>", size_of::<GpuMaterial>(), "materials"),
+        bytes: |d| bytemuck::cast_slice(&d.materials),
+    },
+    SceneBinding {
+        binding: scene(7, "lights", "array<Light>", size_of::<GpuLight>(), "lights"),
+        bytes: |d| bytemuck::cast_slice(&d.lights),
+    },
+    SceneBinding {
+        binding: scene(8, "light_alias", "array<AliasEntry>", size_of::<GpuAliasEntry>(), "light alias table"),
+        bytes: |d| bytemuck::cast_slice(&d.light_alias),
+    },
+    SceneBinding {
+        binding: scene(9, "tex_info", "array<TextureInfo>", size_of::<GpuTextureInfo>(), "texture table"),
+        bytes: |d| bytemuck::cast_slice(&d.tex_info),
+    },
+    SceneBinding {
+        binding: scene(10, "tex_texels", "array<u32>", 4, "texels"),
+        bytes: |d| bytemuck::cast_slice(&d.tex_texels),
+    },
+    SceneBinding {
+        binding: Binding {
+            note: "Environment texels: rgb radiance (unscaled) and, in w, the texel's sampling density in (u, v).",
+            ..scene(11, "env_texels", "array<vec4<f32>>", 16, "environment texels")
+        },
+        bytes: |d| bytemuck::cast_slice(&d.env_texels),
+    },
+    SceneBinding {
+        binding: scene(12, "env_alias", "array<AliasEntry>", size_of::<GpuAliasEntry>(), "environment alias table"),
+        bytes: |d| bytemuck::cast_slice(&d.env_alias),
+    },
+    SceneBinding {
+        binding: scene(13, "light_tree", "array<LightNode>", size_of::<GpuLightNode>(), "light tree"),
+        bytes: |d| bytemuck::cast_slice(&d.light_tree),
+    },
+];
+
+/// Group 1: the per-render state, in binding order.
+pub const FRAME: [Binding; 4] = [
+    Binding {
+        group: 1,
+        binding: 0,
+        name: "params",
+        wgsl_type: "FrameParams",
+        access: Access::Uniform,
+        element_size: size_of::<GpuFrameParams>(),
+        label: "frame parameters",
+        note: "",
+    },
+    Binding {
+        group: 1,
+        binding: 1,
+        name: "accum",
+        wgsl_type: "array<Accum>",
+        access: Access::ReadWrite,
+        element_size: size_of::<GpuAccum>(),
+        label: "accumulation",
+        note: "",
+    },
+    Binding {
+        group: 1,
+        binding: 2,
+        name: "counters",
+        wgsl_type: "array<atomic<u32>>",
+        access: Access::ReadWrite,
+        element_size: 4,
+        label: "counters",
+        note: "counters[0]: non-finite samples; counters[1]: rays traced (both read and cleared by the host after \
+               each submission, which sums them in 64 bits).",
+    },
+    Binding {
+        group: 1,
+        binding: 3,
+        name: "sampler_data",
+        wgsl_type: "array<u32>",
+        access: Access::Read,
+        element_size: 4,
+        label: "sampler tables",
+        note:
+            "The samplers' constant tables (src/render/samplers.rs `sampler_data`: Sobol matrices, primes, blue-noise mask).",
+    },
+];
+
+/// Every binding of the render pipeline.
+pub fn all() -> impl Iterator<Item = Binding> {
+    SCENE.iter().map(|s| s.binding).chain(FRAME)
+}
+
+/// The WGSL declaration of `b`, with its note as a comment above it.
+pub fn wgsl_declaration(b: &Binding) -> String {
+    let var = match b.access {
+        Access::Uniform => "var<uniform>",
+        Access::Read => "var<storage, read>",
+        Access::ReadWrite => "var<storage, read_write>",
+    };
+    let note = if b.note.is_empty() { String::new() } else { format!("// {}\n", b.note) };
+    format!("{note}@group({}) @binding({}) {var} {}: {};\n", b.group, b.binding, b.name, b.wgsl_type)
+}
+
+/// `geometry_bindings.wgsl`: the geometry bindings (group 0, 0–4), for BVH traversal.
+pub fn geometry_wgsl() -> String {
+    let mut s =
+        String::from("// geometry_bindings.wgsl — generated from src/render/bindings.rs: the scene's geometry.\n\n");
+    for b in &SCENE[..GEOMETRY_BINDINGS as usize] {
+        s += &wgsl_declaration(&b.binding);
+    }
+    s
+}
+
+/// `shading_bindings.wgsl`: the rest of group 0 (materials, lights, textures, environment) and group 1.
+pub fn shading_wgsl() -> String {
+    let mut s = String::from(
+        "// shading_bindings.wgsl — generated from src/render/bindings.rs: materials, lights, textures, environment\n\
+         // (group 0) and the per-render state (group 1).\n\n",
+    );
+    for b in &SCENE[GEOMETRY_BINDINGS as usize..] {
+        s += &wgsl_declaration(&b.binding);
+    }
+    s += "\n";
+    for b in &FRAME {
+        s += &wgsl_declaration(b);
+    }
+    s += "\n/// Rays traced by this invocation (summed into counters[1] once per invocation).\nvar<private> rays_traced: u32;\n";
+    s
+}
+
+/// The bind-group layout entry of `b` (compute stage).
+pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
+    let ty = match b.access {
+        Access::Uniform => wgpu::BufferBindingType::Uniform,
+        Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
+        Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
+    };
+    let min_binding_size = match b.access {
+        Access::Uniform => wgpu::BufferSize::new(b.element_size as u64),
+        _ => None,
+    };
+    wgpu::BindGroupLayoutEntry {
+        binding: b.binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size },
+        count: None,
+    }
+}

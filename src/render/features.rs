@@ -1,0 +1,256 @@
+//! Features: what a scene uses, derived from its flattened data, and the pipeline constants that compile
+//! out everything else. `Settings` decide which techniques run; `Features` decide which code exists.
+
+use crate::gpu::types::*;
+use crate::render::scene_data::SceneData;
+use crate::render::settings::Settings;
+
+/// What kind of environment the scene has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EnvKind {
+    /// Black.
+    None = 0,
+    /// Constant radiance.
+    Constant = 1,
+    /// Equirectangular map.
+    Map = 2,
+    /// Decided at run time (the generic pipeline).
+    Any = 3,
+}
+
+/// The scene's features. `Features::generic()` has everything on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Features {
+    /// Triangles in the BVH.
+    pub triangles: bool,
+    /// Analytic spheres.
+    pub spheres: bool,
+    /// Analytic quads.
+    pub quads: bool,
+    /// Emissive triangles.
+    pub triangle_lights: bool,
+    /// Emissive spheres.
+    pub sphere_lights: bool,
+    /// Emissive quads.
+    pub quad_lights: bool,
+    /// Point, spot or directional lights.
+    pub delta_lights: bool,
+    /// Environment kind.
+    pub env: EnvKind,
+    /// Any texture.
+    pub textures: bool,
+    /// Any material with a GGX lobe.
+    pub specular: bool,
+    /// Any material with a diffuse lobe.
+    pub diffuse: bool,
+    /// Any `MaterialKind::Conductor` (shaders/bsdf_conductor.wgsl).
+    pub conductor: bool,
+    /// Any `MaterialKind::CoatedDiffuse` (shaders/bsdf_coated_diffuse.wgsl).
+    pub coated_diffuse: bool,
+    /// Any `MaterialKind::Dielectric` (shaders/bsdf_dielectric.wgsl).
+    pub dielectric: bool,
+    /// Any `MaterialKind::DiffuseTransmission` (shaders/bsdf_diffuse_transmission.wgsl).
+    pub diffuse_transmission: bool,
+    /// More than one entry in the light table (light selection needed).
+    pub many_lights: bool,
+    /// Any triangle with a cut-out mask (shaders/alpha.wgsl): the traversal tests alpha at triangle hits.
+    pub alpha: bool,
+    /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
+    /// (src/render/baked.rs): every primitive tested, unrolled, with its data as literals, instead of a BVH walk (no
+    /// stack, no divergent traversal, no buffer reads). None = BVH.
+    pub flat: Option<(u32, u32, u32)>,
+    /// For flat scenes, a hash of the scene data baked into its pipelines' source (src/render/baked.rs), so that a
+    /// pipeline cache never hands one scene's baked pipeline to another; 0 otherwise.
+    pub baked: u64,
+}
+
+impl Features {
+    /// Everything compiled in.
+    pub fn generic() -> Features {
+        Features {
+            triangles: true,
+            spheres: true,
+            quads: true,
+            triangle_lights: true,
+            sphere_lights: true,
+            quad_lights: true,
+            delta_lights: true,
+            env: EnvKind::Any,
+            textures: true,
+            specular: true,
+            diffuse: true,
+            conductor: true,
+            coated_diffuse: true,
+            dielectric: true,
+            diffuse_transmission: true,
+            many_lights: true,
+            alpha: true,
+            flat: None,
+            baked: 0,
+        }
+    }
+
+    /// What `data` needs.
+    pub fn of(data: &SceneData) -> Features {
+        // The metallic-roughness materials (other kinds have their own constants).
+        let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
+        let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
+        let alpha = data.tri_shading.iter().any(|t| t.alpha_texture != 0);
+        let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
+            (false, _) => EnvKind::None,
+            (true, false) => EnvKind::Constant,
+            (true, true) => EnvKind::Map,
+        };
+        Features {
+            triangles: !data.tri_shading.is_empty(),
+            spheres: !data.spheres.is_empty(),
+            quads: !data.quads.is_empty(),
+            triangle_lights: kinds(LIGHT_TRIANGLE),
+            sphere_lights: kinds(LIGHT_SPHERE),
+            quad_lights: kinds(LIGHT_QUAD),
+            delta_lights: kinds(LIGHT_POINT) || kinds(LIGHT_SPOT) || kinds(LIGHT_DIRECTIONAL),
+            env,
+            textures: !data.tex_info.is_empty(),
+            specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
+            diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
+            conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
+            coated_diffuse: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_COATED_DIFFUSE),
+            dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
+            diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
+            many_lights: data.lights.len() > 1,
+            alpha,
+            // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
+            flat: crate::render::baked::flat_counts(data).filter(|_| !alpha),
+            baked: crate::render::baked::scene_data_source(data).map_or(0, |src| {
+                use std::hash::{Hash, Hasher};
+                let mut h = std::collections::hash_map::DefaultHasher::new();
+                src.hash(&mut h);
+                h.finish() | 1
+            }),
+        }
+    }
+
+    /// The WGSL override constants for these features.
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        let b = |x: bool| if x { 1.0 } else { 0.0 };
+        vec![
+            ("HAS_TRIANGLES", b(self.triangles)),
+            ("HAS_SPHERES", b(self.spheres)),
+            ("HAS_QUADS", b(self.quads)),
+            ("HAS_TRIANGLE_LIGHTS", b(self.triangle_lights)),
+            ("HAS_SPHERE_LIGHTS", b(self.sphere_lights)),
+            ("HAS_QUAD_LIGHTS", b(self.quad_lights)),
+            ("HAS_DELTA_LIGHTS", b(self.delta_lights)),
+            ("ENV_KIND", self.env as u32 as f64),
+            ("HAS_TEXTURES", b(self.textures)),
+            ("HAS_SPECULAR", b(self.specular)),
+            ("HAS_DIFFUSE", b(self.diffuse)),
+            ("HAS_CONDUCTOR", b(self.conductor)),
+            ("HAS_COATED_DIFFUSE", b(self.coated_diffuse)),
+            ("HAS_DIELECTRIC", b(self.dielectric)),
+            ("HAS_DIFFUSE_TRANSMISSION", b(self.diffuse_transmission)),
+            ("MANY_LIGHTS", b(self.many_lights)),
+            ("HAS_ALPHA", b(self.alpha)),
+            ("FLAT_SCENE", b(self.flat.is_some())),
+        ]
+    }
+
+    /// Human-readable list of the code paths compiled in (for `mislab info`).
+    pub fn describe(&self) -> String {
+        let mut v = vec![];
+        let mut on = |name: &str, x: bool| {
+            if x {
+                v.push(name.to_string())
+            }
+        };
+        on("triangles", self.triangles);
+        on("spheres", self.spheres);
+        on("quads", self.quads);
+        on("triangle lights", self.triangle_lights);
+        on("sphere lights", self.sphere_lights);
+        on("quad lights", self.quad_lights);
+        on("point/spot/directional lights", self.delta_lights);
+        on("textures", self.textures);
+        on("GGX lobe", self.specular);
+        on("diffuse lobe", self.diffuse);
+        on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);
+        on("coated diffuse (GGX dielectric coat over Lambert)", self.coated_diffuse);
+        on("dielectric (Fresnel reflection and refraction)", self.dielectric);
+        on("diffuse transmission", self.diffuse_transmission);
+        on("light selection", self.many_lights);
+        on("alpha cut-outs", self.alpha);
+        if let Some((t, s, q)) = self.flat {
+            v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));
+        }
+        v.push(format!("environment: {:?}", self.env).to_lowercase());
+        v.join(", ")
+    }
+}
+
+/// Which pipeline to build: the scene's features, and the settings fixed at compile time (None = read at
+/// run time from the uniform, for the viewer's generic pipeline).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineKey {
+    /// Scene features.
+    pub features: Features,
+    /// Fixed estimator choices, or dynamic.
+    pub fixed: Option<FixedSettings>,
+}
+
+/// The enum-valued settings a specialised pipeline fixes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FixedSettings {
+    /// Tags, in the order of the `SPEC_*` constants.
+    pub tags: [u32; 9],
+}
+
+/// Names of the settings constants, in `FixedSettings::tags` order.
+pub const SETTINGS_CONSTANTS: [&str; 9] = [
+    "SPEC_MODE",
+    "SPEC_STRATEGY",
+    "SPEC_LIGHT_SAMPLING",
+    "SPEC_ENV_SAMPLING",
+    "SPEC_LIGHT_SELECT",
+    "SPEC_HEURISTIC",
+    "SPEC_MIS_KIND",
+    "SPEC_SAMPLER",
+    "SPEC_ONE_DIRECTION",
+];
+
+impl FixedSettings {
+    /// The enum choices of `s`.
+    pub fn of(s: &Settings) -> FixedSettings {
+        FixedSettings {
+            tags: [
+                s.mode.tag(),
+                s.strategy.tag(),
+                s.light_sampling.tag(),
+                s.env_sampling.tag(),
+                s.light_select.tag(),
+                s.heuristic.tag(),
+                s.mis.tag(),
+                s.sampler.tag(),
+                u32::from(s.bsdf_samples <= 1),
+            ],
+        }
+    }
+}
+
+impl PipelineKey {
+    /// Fully specialised to a scene and settings.
+    pub fn specialized(features: Features, settings: &Settings) -> PipelineKey {
+        PipelineKey { features, fixed: Some(FixedSettings::of(settings)) }
+    }
+    /// Everything decided at run time.
+    pub fn generic() -> PipelineKey {
+        PipelineKey { features: Features::generic(), fixed: None }
+    }
+    /// All override constants of this key.
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        let mut c = self.features.constants();
+        if let Some(f) = self.fixed {
+            c.extend(SETTINGS_CONSTANTS.iter().zip(f.tags).map(|(n, t)| (*n, t as f64)));
+        }
+        c
+    }
+}

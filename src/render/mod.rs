@@ -1,0 +1,22 @@
+//! The renderer: a scene flattened and uploaded (`scene_data`, `gpu_scene`, `lights`) through one binding table
+//! (`bindings`), the shaders composed (`shaders`) and specialised by settings and scene features (`settings`,
+//! `features`, `baked`, `pipeline_cache`), the `Renderer` that owns the accumulation and is advanced one way
+//! (`renderer`, `progressive`), and the film it produces.
+
+pub mod baked;
+pub mod bindings;
+pub mod error;
+pub mod features;
+pub mod film;
+pub mod gpu_scene;
+pub mod lights;
+pub mod pipeline_cache;
+pub mod progressive;
+pub mod reachability;
+pub mod renderer;
+pub mod samplers;
+pub mod scene_data;
+pub mod settings;
+pub mod shaders;
+
+pub use renderer::*;

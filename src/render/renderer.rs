@@ -1,0 +1,696 @@
+//! Renderer: the render pipeline, per-render buffers (frame parameters, accumulation, counters),
+//! progressive dispatch, reset and readback.
+
+use crate::gpu::timer::GpuTimer;
+use crate::gpu::types::*;
+use crate::gpu::{GpuContext, GpuError};
+use crate::render::bindings;
+pub use crate::render::error::RenderError;
+use crate::render::features::{Features, PipelineKey};
+use crate::render::film::Film;
+use crate::render::gpu_scene::GpuScene;
+use crate::render::pipeline_cache::PipelineCache;
+pub use crate::render::settings::RR_DEPTH;
+use crate::render::settings::{Mode, Settings};
+use crate::render::shaders;
+use crate::scene::Camera;
+use std::time::Instant;
+
+/// WGSL files of the render entry point, in order.
+pub const RENDER_FILES: &[&str] = &[
+    "common.wgsl",
+    "geometry_bindings.wgsl",
+    "shading_bindings.wgsl",
+    "specialize.wgsl",
+    "rng.wgsl",
+    "samplers.wgsl",
+    "warps.wgsl",
+    "bvh.wgsl",
+    "baked_geometry.wgsl",
+    "scene_data.wgsl",
+    "bsdf_conductor.wgsl",
+    "bsdf_coated_diffuse.wgsl",
+    "bsdf_dielectric.wgsl",
+    "bsdf_diffuse_transmission.wgsl",
+    "bsdf.wgsl",
+    "surface.wgsl",
+    "alpha.wgsl",
+    "lights.wgsl",
+    "light_tree.wgsl",
+    "mis.wgsl",
+    "estimators.wgsl",
+    "integrator.wgsl",
+];
+
+/// The render module that reads the scene from its buffers (the generic pipeline, shared between scenes).
+pub fn render_source() -> String {
+    shaders::compose(RENDER_FILES, "")
+}
+
+/// The render module for one scene: with its data baked in when it is small enough (`Features::flat`), else
+/// `render_source()`.
+pub fn render_source_for(data: &crate::render::scene_data::SceneData) -> String {
+    match crate::render::baked::scene_data_source(data) {
+        Some((data, geometry)) => {
+            shaders::compose_replacing(RENDER_FILES, &[("scene_data.wgsl", &data), ("baked_geometry.wgsl", &geometry)])
+        }
+        None => render_source(),
+    }
+}
+
+/// Most pixel samples `Renderer::render` submits before it waits on the device: bounds each wait well below
+/// `gpu::DEVICE_WAIT_TIMEOUT` however long the render, and the device's 32-bit ray counter between readbacks.
+pub const PIXEL_SAMPLES_PER_WAIT: u64 = 1 << 22;
+
+/// What a timed render did (`Renderer::render_timed`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Sum of the render passes' GPU durations (timestamp queries); None without TIMESTAMP_QUERY.
+    pub gpu: Option<f64>,
+    /// Wall time of submitting and waiting (readbacks for metrics excluded).
+    pub wall: f64,
+    /// Rays traced.
+    pub rays: u64,
+}
+
+impl Timing {
+    /// GPU time where measured, else wall time.
+    pub fn seconds(&self) -> f64 {
+        self.gpu.unwrap_or(self.wall)
+    }
+}
+
+/// A sample pass recorded band by band (the viewer bounds its frame time this way): its samples per pixel and the
+/// first row not yet recorded.
+#[derive(Clone, Copy, Debug)]
+struct PassInFlight {
+    spp: u32,
+    next_row: u32,
+}
+
+/// A progressive renderer of one scene with one set of settings (change either → reset).
+///
+/// Samples advance one way only: `record_band` (or `record`, a whole-film band) records a pass of `spp` samples
+/// per pixel, and `samples()` grows by `spp` when the pass has covered every row. `render` and `render_timed`
+/// are loops over `record` for headless callers.
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: PipelineCache,
+    /// The scene's features (what a specialised pipeline compiles in).
+    features: Features,
+    /// Whether pipelines are specialised to the settings (headless) or read them at run time (viewer).
+    specialize: bool,
+    /// The pipeline `warm_up` last ran (compiled on the driver), if any.
+    warmed: Option<PipelineKey>,
+    scene_group: wgpu::BindGroup,
+    frame_group: wgpu::BindGroup,
+    params_buffer: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    settings: Settings,
+    camera: Camera,
+    /// Samples per pixel of the complete passes since the last reset.
+    samples: u32,
+    /// The pass being recorded band by band, if one is.
+    pass: Option<PassInFlight>,
+    /// The film rows every pass covers (all by default; `set_row_window`).
+    window: std::ops::Range<u32>,
+    /// Target count of the fixed-count samplers (`FrameParams::sampler_spp`; see `samplers::check_spp`).
+    sampler_spp: u32,
+    /// Samples per pixel per dispatch instead of `max_dispatch_spp`'s safe default.
+    dispatch_spp: Option<u32>,
+    /// Non-finite samples since the last reset (device counter, summed on the host).
+    nonfinite_total: u64,
+    /// Rays traced since the last reset.
+    rays_total: u64,
+    env_light: u32,
+    env_size: (u32, u32),
+    env_constant: [f32; 3],
+    env_scale: f32,
+    env_rotation: f32,
+    num_lights: u32,
+    /// The scene's render origin (`SceneData::origin`): the camera is placed relative to it.
+    origin: glam::Vec3,
+    offset_scale: f32,
+    /// This scene's render module (`render_source_for`) and the shared one (`render_source`).
+    source: String,
+    shared_source: String,
+}
+
+impl Renderer {
+    /// Builds the pipeline and the per-render buffers for `scene` at the settings' film size.
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        camera: Camera,
+        settings: Settings,
+    ) -> Result<Renderer, RenderError> {
+        let mut r = Renderer::new_unprepared(ctx, scene, camera, settings)?;
+        r.prepare()?;
+        r.warm_up(ctx)?;
+        Ok(r)
+    }
+
+    /// The per-render buffers only, with no pipeline yet: the viewer compiles pipelines on another
+    /// thread and hands them in with `insert_pipeline` (compiling takes seconds on lavapipe).
+    pub fn new_unprepared(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        camera: Camera,
+        settings: Settings,
+    ) -> Result<Renderer, RenderError> {
+        settings.validate().map_err(RenderError::Settings)?;
+        let device = ctx.device.clone();
+        let scene_entries: Vec<_> = bindings::SCENE.iter().map(|b| bindings::layout_entry(&b.binding)).collect();
+        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &scene_entries,
+        });
+        let frame_entries: Vec<_> = bindings::FRAME.iter().map(bindings::layout_entry).collect();
+        let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &frame_entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("render"),
+            bind_group_layouts: &[Some(&layout0), Some(&layout1)],
+            immediate_size: 0,
+        });
+        let entries: Vec<wgpu::BindGroupEntry> = scene
+            .buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .collect();
+        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout0,
+            entries: &entries,
+        });
+        let pixels = settings.width as u64 * settings.height as u64;
+        let accum_bytes = pixels * std::mem::size_of::<GpuAccum>() as u64;
+        if accum_bytes > ctx.max_storage_binding() {
+            return Err(RenderError::FilmTooLarge {
+                width: settings.width,
+                height: settings.height,
+                need_mib: accum_bytes >> 20,
+                limit_mib: ctx.max_storage_binding() >> 20,
+            });
+        }
+        let accum = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accum"),
+            size: accum_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let counters = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("counters"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<GpuFrameParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let sampler_data =
+            ctx.storage_buffer("sampler_data", crate::render::samplers::sampler_data(), wgpu::BufferUsages::empty());
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &layout1,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: accum.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: counters.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: sampler_data.as_entire_binding() },
+            ],
+        });
+        let d = &scene.data;
+        let film_height = settings.height;
+        let mut r = Renderer {
+            device,
+            queue: ctx.queue.clone(),
+            pipeline_layout,
+            pipelines: PipelineCache::default(),
+            features: Features::of(d),
+            specialize: true,
+            warmed: None,
+            scene_group,
+            frame_group,
+            params_buffer,
+            accum,
+            counters,
+            settings,
+            camera,
+            samples: 0,
+            pass: None,
+            window: 0..film_height,
+            sampler_spp: crate::render::samplers::DEFAULT_SAMPLER_SPP,
+            dispatch_spp: None,
+            nonfinite_total: 0,
+            rays_total: 0,
+            env_light: d.env_light.unwrap_or(INVALID),
+            env_size: d.env_size,
+            env_constant: d.env_constant,
+            env_scale: d.env_scale,
+            env_rotation: d.env_rotation,
+            num_lights: d.lights.len() as u32,
+            origin: d.origin,
+            offset_scale: d.offset_scale,
+            source: render_source_for(d),
+            shared_source: render_source(),
+        };
+        r.reset();
+        Ok(r)
+    }
+
+    /// The layout every render pipeline of this renderer uses (to build one on another thread).
+    pub fn pipeline_layout(&self) -> &wgpu::PipelineLayout {
+        &self.pipeline_layout
+    }
+
+    /// Whether the pipeline for `key` is built.
+    pub fn has_pipeline(&self, key: &PipelineKey) -> bool {
+        self.pipelines.contains(key)
+    }
+
+    /// Adds a pipeline built elsewhere with a layout equal to `pipeline_layout()` (wgpu deduplicates
+    /// equal bind group layouts, so renderers of scenes with the same bindings can share pipelines).
+    pub fn insert_pipeline(&mut self, key: PipelineKey, pipeline: wgpu::ComputePipeline) {
+        self.pipelines.insert(key, pipeline);
+    }
+
+    /// The pipeline built for `key`, to share with another renderer (`insert_pipeline`).
+    pub fn pipeline(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
+        self.pipelines.get(key)
+    }
+
+    /// The pipeline key the current settings need.
+    pub fn key(&self) -> PipelineKey {
+        if self.specialize {
+            PipelineKey::specialized(self.features, &self.settings)
+        } else {
+            PipelineKey::generic()
+        }
+    }
+
+    /// The module a pipeline with `key` is built from: this scene's baked source for its baked pipelines, else the
+    /// shared one (generic pipelines are shared between scenes; see `insert_pipeline`).
+    pub fn source_for(&self, key: &PipelineKey) -> &str {
+        if key.features.baked != 0 {
+            &self.source
+        } else {
+            &self.shared_source
+        }
+    }
+
+    /// Replaces the source of baked pipelines (a renderer that compiles other scenes' pipelines ahead of use,
+    /// like the viewer's warm-up renderer); forgets the baked pipelines built from the old one.
+    pub fn set_baked_source(&mut self, source: &str) {
+        if self.source != source {
+            self.source = source.to_string();
+            self.pipelines.retain(|k| k.features.baked == 0);
+        }
+    }
+
+    /// Builds (or finds in the cache) the pipeline for the current settings.
+    pub fn prepare(&mut self) -> Result<(), RenderError> {
+        let key = self.key();
+        let (device, layout) = (&self.device, &self.pipeline_layout);
+        let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
+        self.pipelines
+            .get_or_build(key, || {
+                shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
+            })
+            .map_err(RenderError::Pipeline)?;
+        Ok(())
+    }
+
+    /// Switches between specialised and generic pipelines (the viewer runs the generic one while a
+    /// specialised one compiles). Does not reset: both compute the same estimate.
+    pub fn set_specialize(&mut self, on: bool) -> Result<(), RenderError> {
+        self.specialize = on;
+        self.prepare()
+    }
+
+    /// Points a warm-up renderer (one that runs other scenes' pipelines once, so that the driver compiles them
+    /// ahead of use) at pipeline `key` with `settings` (its film size kept). False when this renderer cannot run
+    /// `key` with those settings.
+    pub fn aim_at(&mut self, key: PipelineKey, settings: Settings) -> bool {
+        self.features = key.features;
+        self.settings = Settings { width: self.settings.width, height: self.settings.height, ..settings };
+        self.specialize = key.fixed.is_some();
+        self.key() == key
+    }
+
+    /// Runs a zero-sample dispatch: drivers such as lavapipe compile the pipeline at its first use
+    /// (seconds for the render kernel), and that belongs to start-up, not to the render time.
+    pub fn warm_up(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        self.record_warm_up(&mut enc);
+        self.queue.submit([enc.finish()]);
+        ctx.wait_at_most(crate::gpu::PIPELINE_COMPILE_TIMEOUT)?;
+        self.warmed = Some(self.key());
+        Ok(())
+    }
+
+    /// Records a zero-sample dispatch of the current pipeline (see `warm_up`); the caller submits and waits.
+    pub fn record_warm_up(&mut self, enc: &mut wgpu::CommandEncoder) {
+        self.dispatch(enc, 0, 0, self.settings.height, None);
+    }
+
+    /// Forgets every accumulated sample (the next pass starts from sample 0).
+    pub fn reset(&mut self) {
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.accum, 0, None);
+        enc.clear_buffer(&self.counters, 0, None);
+        self.queue.submit([enc.finish()]);
+        self.samples = 0;
+        self.pass = None;
+        self.nonfinite_total = 0;
+        self.rays_total = 0;
+    }
+
+    /// Continues from saved accumulators (a render state file, `state::RenderState`): the film holds `accum`
+    /// exactly and the next pass starts at sample index `samples`.
+    pub fn restore(
+        &mut self,
+        accum: &[GpuAccum],
+        samples: u32,
+        nonfinite_total: u64,
+        rays_total: u64,
+    ) -> Result<(), RenderError> {
+        let pixels = self.settings.width as usize * self.settings.height as usize;
+        if accum.len() != pixels {
+            return Err(RenderError::StateSize { got: accum.len(), want: pixels });
+        }
+        self.reset();
+        self.queue.write_buffer(&self.accum, 0, bytemuck::cast_slice(accum));
+        self.samples = samples;
+        self.nonfinite_total = nonfinite_total;
+        self.rays_total = rays_total;
+        Ok(())
+    }
+
+    /// Changes settings (film size excluded), resets and builds the pipeline they need.
+    pub fn set_settings(&mut self, settings: Settings) -> Result<(), RenderError> {
+        self.configure(settings)?;
+        self.prepare()
+    }
+
+    /// Changes settings (film size excluded) and resets, without building a pipeline (the viewer's compile worker
+    /// builds them on another thread).
+    pub fn configure(&mut self, settings: Settings) -> Result<(), RenderError> {
+        settings.validate().map_err(RenderError::Settings)?;
+        if settings.width != self.settings.width || settings.height != self.settings.height {
+            return Err(RenderError::FilmSizeChange);
+        }
+        self.settings = settings;
+        self.reset();
+        Ok(())
+    }
+
+    /// Moves the camera and resets.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+        self.reset();
+    }
+
+    /// Settings in force.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Camera in force.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The scene's features (what a specialised pipeline compiles in).
+    pub fn features(&self) -> Features {
+        self.features
+    }
+
+    /// Whether pipelines are specialised to the settings.
+    pub fn is_specialized(&self) -> bool {
+        self.specialize
+    }
+
+    /// Samples per pixel accumulated in every pixel since the last reset (complete passes).
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// The first row of the pass being recorded band by band not yet recorded (0 when no pass is in flight).
+    pub fn pass_row(&self) -> u32 {
+        self.pass.map_or(0, |p| p.next_row)
+    }
+
+    /// Samples per pixel of the pass in flight, if one is.
+    pub fn pass_spp(&self) -> Option<u32> {
+        self.pass.map(|p| p.spp)
+    }
+
+    /// Non-finite samples since the last reset (counted on the device, kept out of the image).
+    pub fn nonfinite_total(&self) -> u64 {
+        self.nonfinite_total
+    }
+
+    /// Rays traced since the last reset.
+    pub fn rays_total(&self) -> u64 {
+        self.rays_total
+    }
+
+    /// Sets the fixed-count samplers' target count (`samplers::check_spp`); a change resets (the points differ).
+    pub fn set_sampler_spp(&mut self, n: u32) {
+        if n != self.sampler_spp {
+            self.sampler_spp = n;
+            self.reset();
+        }
+    }
+
+    /// Samples per pixel per dispatch instead of `max_dispatch_spp`'s safe default: only for scenes so simple
+    /// that a sample's loops are short (check the film's sample counts: the driver drops what its budget cuts).
+    pub fn set_dispatch_spp(&mut self, n: Option<u32>) {
+        self.dispatch_spp = n.map(|n| n.max(1));
+    }
+
+    /// The frame parameters of a dispatch of `spp` samples starting at the current sample count.
+    pub fn frame_params(&self, spp: u32) -> GpuFrameParams {
+        let s = &self.settings;
+        let (right, up, forward) = self.camera.frame();
+        GpuFrameParams {
+            width: s.width,
+            height: s.height,
+            sample_base: self.samples,
+            samples_per_dispatch: spp,
+            seed: s.seed,
+            mode: s.mode.tag(),
+            max_depth: if s.mode == Mode::Direct { 1 } else { s.max_depth },
+            strategy: s.strategy.tag(),
+            light_sampling: s.light_sampling.tag(),
+            env_sampling: s.env_sampling.tag(),
+            light_select: s.light_select.tag(),
+            heuristic: s.heuristic.tag(),
+            power_beta: s.power_beta,
+            light_samples: s.light_samples,
+            bsdf_samples: s.bsdf_samples,
+            mis_kind: s.mis.tag(),
+            sampler: s.sampler.tag(),
+            num_lights: self.num_lights,
+            rr_depth: s.rr_depth,
+            env_light: self.env_light,
+            cam_origin: (self.camera.position - self.origin).into(),
+            tan_half_fov: (0.5 * self.camera.vfov).tan(),
+            cam_right: right.into(),
+            aspect: s.width as f32 / s.height as f32,
+            cam_up: up.into(),
+            env_scale: self.env_scale,
+            cam_forward: forward.into(),
+            env_rotation: self.env_rotation,
+            env_constant: self.env_constant,
+            env_width: self.env_size.0,
+            env_height: self.env_size.1,
+            sampler_spp: self.sampler_spp,
+            row_offset: 0,
+            row_count: s.height,
+            offset_scale: self.offset_scale,
+            ris_candidates: s.ris_candidates,
+            _pad1: 0,
+            _pad2: 0,
+        }
+    }
+
+    /// Restricts every pass to film rows `rows` (the others stay empty: a test that needs a few rows of a big
+    /// film renders only those) and resets.
+    pub fn set_row_window(&mut self, rows: std::ops::Range<u32>) {
+        let h = self.settings.height;
+        self.window = rows.start.min(h)..rows.end.clamp(rows.start.min(h), h);
+        self.reset();
+    }
+
+    /// Records a whole pass (every row of the window) of `spp` samples per pixel into `enc` (see `record_band`).
+    pub fn record(&mut self, enc: &mut wgpu::CommandEncoder, spp: u32, timer: Option<&mut GpuTimer>) {
+        let rows = self.settings.height;
+        let done = self.record_band(enc, spp, rows, timer);
+        debug_assert!(done, "a whole-film band completes its pass");
+    }
+
+    /// Records the next `rows` rows of a pass of `spp` samples per pixel into `enc`, after the rows recorded
+    /// before (a pass started with one `spp` keeps it until it is complete). Returns whether this band completed
+    /// the pass: then `samples()` has grown by `spp`. `timer` times the dispatch. The frame parameters go to the
+    /// queue at once, so submit `enc` before recording the next band.
+    pub fn record_band(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        spp: u32,
+        rows: u32,
+        timer: Option<&mut GpuTimer>,
+    ) -> bool {
+        let end = self.window.end;
+        let pass = self.pass.unwrap_or(PassInFlight { spp, next_row: self.window.start });
+        let rows = rows.min(end - pass.next_row);
+        let writes = timer.and_then(|t| t.pass());
+        self.dispatch(enc, pass.spp, pass.next_row, rows, writes);
+        let next_row = pass.next_row + rows;
+        if next_row >= end {
+            self.pass = None;
+            self.samples += pass.spp;
+            true
+        } else {
+            self.pass = Some(PassInFlight { next_row, ..pass });
+            false
+        }
+    }
+
+    /// One dispatch of `spp` samples per pixel, starting at sample index `samples`, over film rows
+    /// `row_offset .. row_offset + row_count`.
+    fn dispatch(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        spp: u32,
+        row_offset: u32,
+        row_count: u32,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let p = GpuFrameParams { row_offset, row_count, ..self.frame_params(spp) };
+        self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
+        let mut pass = enc
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: timestamps });
+        let pipeline = self.pipelines.get(&self.key()).expect("prepare() builds the pipeline before recording");
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.scene_group, &[]);
+        pass.set_bind_group(1, &self.frame_group, &[]);
+        pass.dispatch_workgroups(self.settings.width.div_ceil(8), row_count.div_ceil(8), 1);
+    }
+
+    /// Renders `spp` more samples per pixel and waits for them (with the device timeout): dispatches of at most
+    /// `max_dispatch_spp()` samples, one submission each, one wait at the end.
+    pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), RenderError> {
+        self.prepare()?;
+        // The compile of a pipeline's first use gets its own, longer wait (see PIPELINE_COMPILE_TIMEOUT), so the
+        // device timeout below bounds sample work only.
+        if self.warmed != Some(self.key()) {
+            self.warm_up(ctx)?;
+        }
+        // lavapipe (Mesa 22.3) gives each invocation one budget of 65535 loop iterations shared by all
+        // its loops and silently stops looping when it is spent: a 1024-spp dispatch accumulated only
+        // ~300-450 samples. Split into small dispatches (one submit each, so each sees its own
+        // parameters) and wait once at the end.
+        let chunk = self.max_dispatch_spp();
+        let pixels = self.settings.width as u64 * self.window.len() as u64;
+        let mut in_flight = 0u64;
+        let mut left = spp;
+        while left > 0 {
+            let n = left.min(chunk);
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            self.record(&mut enc, n, None);
+            self.queue.submit([enc.finish()]);
+            left -= n;
+            in_flight += n as u64 * pixels;
+            if in_flight >= PIXEL_SAMPLES_PER_WAIT || left == 0 {
+                ctx.wait()?;
+                self.collect_counters(ctx)?;
+                in_flight = 0;
+            }
+        }
+        Ok(())
+    }
+
+    /// Renders `spp` more samples per pixel like `render`, but waits after every dispatch and times each with
+    /// `timer` (GPU time) and the wall clock, for benchmarks.
+    pub fn render_timed(
+        &mut self,
+        ctx: &GpuContext,
+        spp: u32,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<Timing, RenderError> {
+        self.prepare()?;
+        let mut timing = Timing { gpu: timer.as_ref().map(|_| 0.0), ..Timing::default() };
+        let rays_before = self.rays_total;
+        let chunk = self.max_dispatch_spp();
+        let mut left = spp;
+        while left > 0 {
+            let n = left.min(chunk);
+            let t0 = Instant::now();
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            self.record(&mut enc, n, timer.as_deref_mut());
+            self.queue.submit([enc.finish()]);
+            ctx.wait()?;
+            timing.wall += t0.elapsed().as_secs_f64();
+            left -= n;
+            let full = timer.as_ref().is_some_and(|t| t.is_full());
+            if full || left == 0 {
+                if let (Some(t), Some(g)) = (timer.as_deref_mut(), timing.gpu.as_mut()) {
+                    *g += t.read(ctx)?.iter().sum::<f64>();
+                }
+                // Also bounds the device's 32-bit ray counter between readbacks.
+                self.collect_counters(ctx)?;
+            }
+        }
+        timing.rays = self.rays_total - rays_before;
+        Ok(timing)
+    }
+
+    /// Most samples per pixel one dispatch may take without exhausting a driver's per-invocation loop
+    /// budget (path tracing through a BVH runs far more traversal steps per sample than direct lighting).
+    pub fn max_dispatch_spp(&self) -> u32 {
+        if let Some(n) = self.dispatch_spp {
+            return n;
+        }
+        // A baked scene's traversal has no loops, so a path sample spends a few loop iterations per vertex
+        // (render_main's vertex loop, shade's sample loops); a BVH walk spends one per node visited.
+        if self.settings.mode == Mode::Path && self.features.flat.is_none() {
+            4
+        } else {
+            16
+        }
+    }
+
+    /// Adds the device counters to the host totals and clears them (u32 on the device would overflow).
+    pub fn collect_counters(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        let c: Vec<u32> = ctx.read_pod(&self.counters, 4)?;
+        self.nonfinite_total += c[0] as u64;
+        self.rays_total += c[1] as u64;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.counters, 0, None);
+        self.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
+    /// Reads the accumulation back.
+    pub fn film(&self, ctx: &GpuContext) -> Result<Film, GpuError> {
+        let n = (self.settings.width * self.settings.height) as usize;
+        let accum: Vec<GpuAccum> = ctx.read_pod(&self.accum, n)?;
+        Ok(Film::from_accum(self.settings.width, self.settings.height, &accum, self.nonfinite_total))
+    }
+
+    /// The accumulation buffer (for the viewer's display pass).
+    pub fn accum_buffer(&self) -> &wgpu::Buffer {
+        &self.accum
+    }
+}

@@ -1,0 +1,520 @@
+//! SceneData: the scene flattened, on the CPU, into the tables the shaders read (geometry + BVH, shading
+//! data, light table, textures, environment distribution); `gpu_scene` uploads them.
+
+use crate::accel::bvh;
+use crate::accel::light_tree::{GpuLightNode, LightBounds, LightTree};
+use crate::gpu::types::*;
+use crate::render::lights::{self, luminance};
+use crate::scene::{Environment, PunctualLight, Scene, TextureRef, Wrap};
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// CPU-side arrays exactly as uploaded, plus statistics. Built without a device so tests can inspect it.
+#[derive(Clone, Debug, Default)]
+pub struct SceneData {
+    /// Three vec4 per triangle.
+    pub tri_verts: Vec<[f32; 4]>,
+    /// Per-triangle shading data.
+    pub tri_shading: Vec<GpuTriShading>,
+    /// Spheres.
+    pub spheres: Vec<GpuSphere>,
+    /// Quads.
+    pub quads: Vec<GpuQuad>,
+    /// Materials.
+    pub materials: Vec<GpuMaterial>,
+    /// Light table.
+    pub lights: Vec<GpuLight>,
+    /// Alias table for power-proportional light selection.
+    pub light_alias: Vec<GpuAliasEntry>,
+    /// The light tree over the lights with a position (`--light-select tree`), depth-first; empty if none.
+    pub light_tree: Vec<GpuLightNode>,
+    /// Texture table.
+    pub tex_info: Vec<GpuTextureInfo>,
+    /// All texels, RGBA8 packed.
+    pub tex_texels: Vec<u32>,
+    /// Environment texels (rgb + density), empty for none/constant.
+    pub env_texels: Vec<[f32; 4]>,
+    /// Environment alias table.
+    pub env_alias: Vec<GpuAliasEntry>,
+    /// Environment width/height (0 for none/constant).
+    pub env_size: (u32, u32),
+    /// Constant environment radiance (when no map).
+    pub env_constant: [f32; 3],
+    /// Map scale / rotation.
+    pub env_scale: f32,
+    /// Rotation about +Y, radians.
+    pub env_rotation: f32,
+    /// Index of the environment in the light table.
+    pub env_light: Option<u32>,
+    /// BVH nodes.
+    pub bvh_nodes: Vec<bvh::GpuBvhNode>,
+    /// BVH primitive references.
+    pub prim_refs: Vec<u32>,
+    /// BVH build time, seconds.
+    pub bvh_seconds: f64,
+    /// BVH SAH cost.
+    pub bvh_sah: f32,
+    /// Number of delta lights (reachable by light sampling only).
+    pub delta_lights: u32,
+    /// World position of the render origin: every position above is relative to it (see `render_origin`).
+    pub origin: Vec3,
+    /// Largest |coordinate| of the geometry around `origin`, clamped to [1e-30, 1]: the length scale of
+    /// ray-origin offsets near the origin (`FrameParams::offset_scale`).
+    pub offset_scale: f32,
+}
+
+/// Beyond this distance of the camera from the world origin, scenes are rendered relative to the camera.
+pub const RECENTER_DISTANCE: f32 = 1024.0;
+
+/// Where positions are measured from on the device. f32 positions 1e5 from the origin are 2^-7 apart, and
+/// ray-origin offsets (256 ULPs) grow to 2 units there, jumping through the walls of a 2-unit Cornell box.
+/// Subtracting the camera position (exact for f32 values within a factor 2 of each other, Sterbenz) keeps
+/// what the camera sees at small magnitudes. Scenes near the origin keep world coordinates unchanged.
+pub fn render_origin(scene: &Scene) -> Vec3 {
+    let c = scene.camera.position;
+    if c.is_finite() && c.abs().max_element() > RECENTER_DISTANCE {
+        c
+    } else {
+        Vec3::ZERO
+    }
+}
+
+impl SceneData {
+    /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device.
+    pub fn build(scene: &Scene) -> SceneData {
+        let mut d = SceneData { origin: render_origin(scene), ..SceneData::default() };
+        let o = d.origin;
+        d.materials = scene.materials.iter().map(gpu_material).collect();
+        if d.materials.is_empty() {
+            d.materials.push(gpu_material(&Default::default()));
+        }
+        let mat_index = |m: u32| if (m as usize) < d.materials.len() { m } else { 0 };
+        // A cut-out mask is read per triangle during traversal (shaders/alpha.wgsl): 0 = none, else texture + 1.
+        let alpha_of = |m: u32| {
+            let t = scene.materials.get(m as usize).and_then(|m| m.alpha_texture);
+            t.filter(|&t| (t as usize) < scene.textures.len()).map_or(0, |t| t + 1)
+        };
+        let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
+        for mesh in &scene.meshes {
+            for t in &mesh.indices {
+                let p = t.map(|i| mesh.positions[i as usize] - o);
+                let n = t.map(|i| mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO));
+                let uv = t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default());
+                tris.push(p);
+                for v in p {
+                    d.tri_verts.push([v.x, v.y, v.z, 0.0]);
+                }
+                d.tri_shading.push(GpuTriShading {
+                    n0: n[0].into(),
+                    n1: n[1].into(),
+                    n2: n[2].into(),
+                    uv0: uv[0].into(),
+                    uv1: uv[1].into(),
+                    uv2: uv[2].into(),
+                    material: mat_index(mesh.material),
+                    light: INVALID,
+                    alpha_texture: alpha_of(mesh.material),
+                    ..Default::default()
+                });
+            }
+        }
+        d.spheres = scene
+            .spheres
+            .iter()
+            .map(|s| GpuSphere {
+                center: (s.center - o).into(),
+                radius: s.radius,
+                material: mat_index(s.material),
+                light: INVALID,
+                ..Default::default()
+            })
+            .collect();
+        d.quads = scene
+            .quads
+            .iter()
+            .map(|q| GpuQuad {
+                corner: (q.corner - o).into(),
+                edge_u: q.edge_u.into(),
+                edge_v: q.edge_v.into(),
+                material: mat_index(q.material),
+                light: INVALID,
+                ..Default::default()
+            })
+            .collect();
+        let mut extent = 0.0f32;
+        for v in tris.iter().flatten() {
+            extent = extent.max(v.abs().max_element());
+        }
+        for s in &scene.spheres {
+            extent = extent.max((s.center - o).abs().max_element() + s.radius);
+        }
+        for q in &scene.quads {
+            let c = q.corner - o;
+            for p in [c, c + q.edge_u, c + q.edge_v, c + q.edge_u + q.edge_v] {
+                extent = extent.max(p.abs().max_element());
+            }
+        }
+        d.offset_scale = if extent.is_finite() && extent > 0.0 { extent.clamp(1e-30, 1.0) } else { 1.0 };
+        let mut bvh = bvh::build(&tris, &d.spheres, &d.quads);
+        // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs.
+        let order = bvh::into_leaf_order(&mut bvh, tris.len());
+        tris = order.iter().map(|&i| tris[i as usize]).collect();
+        d.tri_verts = order.iter().flat_map(|&i| d.tri_verts[3 * i as usize..3 * i as usize + 3].to_vec()).collect();
+        d.tri_shading = order.iter().map(|&i| d.tri_shading[i as usize]).collect();
+        d.bvh_seconds = bvh.build_seconds;
+        d.bvh_sah = bvh.sah_cost;
+        d.bvh_nodes = bvh.nodes;
+        d.prim_refs = bvh.prim_refs;
+        build_textures(scene, &mut d);
+        build_lights(scene, &tris, &mut d);
+        d
+    }
+
+    /// Bytes of geometry + BVH per triangle (0 without triangles).
+    pub fn bvh_bytes(&self) -> usize {
+        self.bvh_nodes.len() * std::mem::size_of::<bvh::GpuBvhNode>() + self.prim_refs.len() * 4
+    }
+}
+
+fn xform(t: &Option<TextureRef>) -> ([f32; 4], [f32; 4], u32) {
+    match t {
+        Some(r) => {
+            let m = r.transform;
+            ([m[0][0], m[0][1], m[0][2], 0.0], [m[1][0], m[1][1], m[1][2], 0.0], r.texture)
+        }
+        None => ([1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], INVALID),
+    }
+}
+
+fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
+    let (b0, b1, bt) = xform(&m.base_color_texture);
+    let (m0, m1, mt) = xform(&m.metallic_roughness_texture);
+    let (e0, e1, et) = xform(&m.emissive_texture);
+    let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
+    let kind = material_kind(m);
+    GpuMaterial {
+        // Kinds that carry their own colour (tint, reflectance) put it in base_color themselves.
+        base_color: if matches!(
+            kind.bsdf_kind,
+            MATERIAL_CONDUCTOR | MATERIAL_DIELECTRIC | MATERIAL_DIFFUSE_TRANSMISSION
+        ) {
+            kind.base_color
+        } else {
+            m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0))
+        },
+        metallic: if kind.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION {
+            kind.metallic
+        } else {
+            finite(m.metallic, 0.0).clamp(0.0, 1.0)
+        },
+        emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
+        alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
+        specular: if kind.bsdf_kind == MATERIAL_CONDUCTOR {
+            kind.specular
+        } else {
+            finite(m.specular, 1.0).clamp(0.0, 1.0)
+        },
+        base_tex: bt,
+        mr_tex: mt,
+        emissive_tex: et,
+        base_xform0: b0,
+        base_xform1: b1,
+        mr_xform0: m0,
+        mr_xform1: m1,
+        em_xform0: e0,
+        em_xform1: e1,
+        ..kind
+    }
+}
+
+/// The kind tag and the kind's own parameters (sanitised: finite, η > 0, k ≥ 0, α ≥ ALPHA_MIN).
+fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
+    use crate::scene::{MaterialKind, ALPHA_MIN};
+    let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
+    let alpha = |a: f32| finite(a, 1.0).clamp(ALPHA_MIN, 1.0);
+    match &m.kind {
+        MaterialKind::MetallicRoughness => GpuMaterial { bsdf_kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
+        MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, beckmann } => GpuMaterial {
+            bsdf_kind: MATERIAL_CONDUCTOR,
+            // specular (unused by this kind): the microfacet distribution, 0 = GGX, 1 = Beckmann.
+            specular: if *beckmann { 1.0 } else { 0.0 },
+            base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
+            eta: eta.to_array().map(|c| finite(c, 1.0).max(1e-3)),
+            k: k.to_array().map(|c| finite(c, 0.0).max(0.0)),
+            alpha: alpha(*alpha_u),
+            alpha_v: alpha(*alpha_v),
+            ..Default::default()
+        },
+        // Reflectance: base_color / base_tex, as for metallic-roughness. η ≥ 1 + 1e-4 (the model has no
+        // total internal reflection from outside; η = 1 would be no coat at all).
+        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v } => GpuMaterial {
+            bsdf_kind: MATERIAL_COATED_DIFFUSE,
+            eta: [finite(*eta, 1.5).clamp(1.0001, 10.0), 1.0, 1.0],
+            alpha: alpha(*alpha_u),
+            alpha_v: alpha(*alpha_v),
+            ..Default::default()
+        },
+        MaterialKind::Dielectric { eta, alpha_u, alpha_v, tint, thin } => GpuMaterial {
+            bsdf_kind: MATERIAL_DIELECTRIC,
+            // η = 1 has no interface to refract at; keep it off 1 so the Walter half vector stays defined.
+            // eta[1]: the thin-slab flag.
+            eta: {
+                let e = finite(*eta, 1.5).clamp(1e-3, 1e3);
+                [if (e - 1.0).abs() < 1e-4 { 1.0001 } else { e }, if *thin { 1.0 } else { 0.0 }, 0.0]
+            },
+            alpha: alpha(*alpha_u),
+            alpha_v: alpha(*alpha_v),
+            base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
+            ..Default::default()
+        },
+        MaterialKind::DiffuseTransmission { reflectance, transmittance, transmittance_textured } => GpuMaterial {
+            bsdf_kind: MATERIAL_DIFFUSE_TRANSMISSION,
+            // metallic (unused by this kind): 1 = the base texture multiplies the transmittance too.
+            metallic: if *transmittance_textured { 1.0 } else { 0.0 },
+            base_color: reflectance.to_array().map(|c| finite(c, 0.0).max(0.0)),
+            k: transmittance.to_array().map(|c| finite(c, 0.0).max(0.0)),
+            ..Default::default()
+        },
+    }
+}
+
+fn wrap_tag(w: Wrap) -> u32 {
+    match w {
+        Wrap::Repeat => WRAP_REPEAT,
+        Wrap::Clamp => WRAP_CLAMP,
+        Wrap::Mirror => WRAP_MIRROR,
+    }
+}
+
+fn build_textures(scene: &Scene, d: &mut SceneData) {
+    for t in &scene.textures {
+        d.tex_info.push(GpuTextureInfo {
+            offset: d.tex_texels.len() as u32,
+            width: t.width,
+            height: t.height,
+            wrap_s: wrap_tag(t.wrap_s),
+            wrap_t: wrap_tag(t.wrap_t),
+            srgb: t.srgb as u32,
+            nearest: t.nearest as u32,
+            _pad0: 0,
+        });
+        d.tex_texels.extend(t.texels.iter().map(|c| u32::from_le_bytes(*c)));
+    }
+}
+
+/// Radius of a sphere bounding every finite primitive (for the power of distant lights).
+fn scene_radius(d: &SceneData) -> f64 {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    let mut add = |p: Vec3, r: f32| {
+        if p.is_finite() {
+            lo = lo.min(p - r);
+            hi = hi.max(p + r);
+        }
+    };
+    for v in &d.tri_verts {
+        add(Vec3::new(v[0], v[1], v[2]), 0.0);
+    }
+    for s in &d.spheres {
+        add(Vec3::from(s.center), s.radius);
+    }
+    for q in &d.quads {
+        let c = Vec3::from(q.corner);
+        add(c, 0.0);
+        add(c + Vec3::from(q.edge_u) + Vec3::from(q.edge_v), 0.0);
+    }
+    if lo.x > hi.x {
+        return 1.0;
+    }
+    (0.5 * (hi - lo).length() as f64).max(1e-3)
+}
+
+fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
+    let mut lights: Vec<GpuLight> = Vec::new();
+    let mut power: Vec<f64> = Vec::new();
+    let emits = |m: u32| {
+        let gm = &d.materials[m as usize];
+        gm.emission.iter().any(|&c| c > 0.0)
+    };
+    // Faces that emit: 2 for a two-sided area emitter.
+    let two_sided =
+        |m: u32| if scene.materials.get(m as usize).is_some_and(|m| m.emission_two_sided) { 2u32 } else { 1 };
+    for (i, t) in tris.iter().enumerate() {
+        let m = d.tri_shading[i].material;
+        if !emits(m) {
+            continue;
+        }
+        let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        if !(area > 0.0 && area.is_finite()) {
+            continue;
+        }
+        d.tri_shading[i].light = lights.len() as u32;
+        // A two-sided emitter radiates π·A·L from each face.
+        let sides = two_sided(m);
+        power.push(PI * area as f64 * luminance(d.materials[m as usize].emission) * sides as f64);
+        let two_sided = (sides == 2) as u32;
+        lights.push(GpuLight { kind: LIGHT_TRIANGLE, prim: i as u32, area, two_sided, ..Default::default() });
+    }
+    for i in 0..d.spheres.len() {
+        let s = d.spheres[i];
+        if !emits(s.material) || !(s.radius > 0.0) {
+            continue;
+        }
+        let area = 4.0 * std::f32::consts::PI * s.radius * s.radius;
+        d.spheres[i].light = lights.len() as u32;
+        power.push(PI * area as f64 * luminance(d.materials[s.material as usize].emission));
+        lights.push(GpuLight { kind: LIGHT_SPHERE, prim: i as u32, area, position: s.center, ..Default::default() });
+    }
+    for i in 0..d.quads.len() {
+        let q = d.quads[i];
+        let area = Vec3::from(q.edge_u).cross(Vec3::from(q.edge_v)).length();
+        if !emits(q.material) || !(area > 0.0 && area.is_finite()) {
+            continue;
+        }
+        d.quads[i].light = lights.len() as u32;
+        let sides = two_sided(q.material);
+        power.push(PI * area as f64 * luminance(d.materials[q.material as usize].emission) * sides as f64);
+        let two_sided = (sides == 2) as u32;
+        lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, two_sided, ..Default::default() });
+    }
+    let r = scene_radius(d);
+    // Lights with a position first, then the infinite ones (directional, environment): the light tree covers
+    // the first `bounded` entries and the shader finds the infinite ones after them.
+    let punctual = scene.punctual_lights.iter().filter(|l| !matches!(l, PunctualLight::Directional { .. }));
+    let directional = scene.punctual_lights.iter().filter(|l| matches!(l, PunctualLight::Directional { .. }));
+    for l in punctual.chain(directional) {
+        let (g, p) = match *l {
+            PunctualLight::Point { position, intensity } => (
+                GpuLight {
+                    kind: LIGHT_POINT,
+                    position: (position - d.origin).into(),
+                    radiance: intensity.into(),
+                    ..Default::default()
+                },
+                4.0 * PI * luminance(intensity.into()),
+            ),
+            PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } => {
+                let (ci, co) = (inner_cone.cos(), outer_cone.cos());
+                let g = GpuLight {
+                    kind: LIGHT_SPOT,
+                    position: (position - d.origin).into(),
+                    direction: direction.normalize_or(Vec3::NEG_Z).into(),
+                    radiance: intensity.into(),
+                    cos_inner: ci.max(co + 1e-6).min(1.0),
+                    cos_outer: co,
+                    ..Default::default()
+                };
+                (g, 2.0 * PI * (1.0 - 0.5 * (ci + co) as f64) * luminance(intensity.into()))
+            }
+            PunctualLight::Directional { direction, irradiance } => (
+                GpuLight {
+                    kind: LIGHT_DIRECTIONAL,
+                    direction: direction.normalize_or(Vec3::NEG_Y).into(),
+                    radiance: irradiance.into(),
+                    ..Default::default()
+                },
+                PI * r * r * luminance(irradiance.into()),
+            ),
+        };
+        d.delta_lights += 1;
+        power.push(p);
+        lights.push(g);
+    }
+    match &scene.environment {
+        Environment::None => {}
+        Environment::Constant(c) => {
+            d.env_constant = (*c).into();
+            d.env_scale = 1.0;
+            if c.max_element() > 0.0 {
+                d.env_light = Some(lights.len() as u32);
+                power.push(4.0 * PI * PI * r * r * luminance((*c).into()));
+                lights.push(GpuLight { kind: LIGHT_ENVIRONMENT, ..Default::default() });
+            }
+        }
+        Environment::Map { map, scale, rotation } => {
+            let dist = lights::env_distribution(map);
+            d.env_size = (map.width, map.height);
+            d.env_scale = *scale;
+            d.env_rotation = *rotation;
+            if dist.mean_luminance * (*scale as f64) > 0.0 {
+                d.env_light = Some(lights.len() as u32);
+                power.push(4.0 * PI * PI * r * r * dist.mean_luminance * *scale as f64);
+                lights.push(GpuLight { kind: LIGHT_ENVIRONMENT, ..Default::default() });
+            }
+            d.env_texels = dist.texels;
+            d.env_alias = dist.alias;
+        }
+    }
+    let table = lights::alias_table(&power);
+    let n = lights.len();
+    for (l, p) in lights.iter_mut().zip(&table.pmf) {
+        l.pmf_power = *p as f32;
+        l.pmf_uniform = 1.0 / n as f32;
+    }
+    let bounded = lights.iter().take_while(|l| !matches!(l.kind, LIGHT_DIRECTIONAL | LIGHT_ENVIRONMENT)).count();
+    debug_assert!(lights[bounded..].iter().all(|l| matches!(l.kind, LIGHT_DIRECTIONAL | LIGHT_ENVIRONMENT)));
+    let bounds: Vec<LightBounds> =
+        lights[..bounded].iter().zip(&power).map(|(l, &p)| light_bounds(l, p, tris, d)).collect();
+    let tree = LightTree::build(&bounds, &(0..bounded as u32).collect::<Vec<_>>());
+    for (l, &trail) in lights.iter_mut().zip(&tree.trails) {
+        l.tree_trail = trail;
+    }
+    d.light_tree = tree.nodes;
+    d.lights = lights;
+    d.light_alias = table.entries;
+}
+
+/// Where light `l` (of power `power`) is and emits, for the light tree: area emitters emit from their front (the
+/// side `*_sample_li` accepts) or, two-sided, from both faces; spheres and point lights emit everywhere, spots
+/// into their outer cone.
+fn light_bounds(l: &GpuLight, power: f64, tris: &[[Vec3; 3]], d: &SceneData) -> LightBounds {
+    let everywhere = |lo: Vec3, hi: Vec3| LightBounds {
+        lo,
+        hi,
+        phi: power as f32,
+        axis: Vec3::Z,
+        cos_o: -1.0,
+        cos_e: 0.0,
+        two_sided: false,
+    };
+    let facing = |pts: &[Vec3], normal: Vec3| {
+        let lo = pts.iter().fold(Vec3::splat(f32::MAX), |a, &p| a.min(p));
+        let hi = pts.iter().fold(Vec3::splat(f32::MIN), |a, &p| a.max(p));
+        LightBounds {
+            axis: normal.normalize_or(Vec3::Z),
+            cos_o: 1.0,
+            two_sided: l.two_sided != 0,
+            ..everywhere(lo, hi)
+        }
+    };
+    match l.kind {
+        LIGHT_TRIANGLE => {
+            let t = tris[l.prim as usize];
+            facing(&t, (t[1] - t[0]).cross(t[2] - t[0]))
+        }
+        LIGHT_QUAD => {
+            let q = d.quads[l.prim as usize];
+            let (c, u, v) = (Vec3::from(q.corner), Vec3::from(q.edge_u), Vec3::from(q.edge_v));
+            facing(&[c, c + u, c + v, c + u + v], u.cross(v))
+        }
+        LIGHT_SPHERE => {
+            let s = d.spheres[l.prim as usize];
+            let c = Vec3::from(s.center);
+            everywhere(c - s.radius, c + s.radius)
+        }
+        LIGHT_SPOT => {
+            let p = Vec3::from(l.position);
+            let (theta_i, theta_o) = (l.cos_inner.clamp(-1.0, 1.0).acos(), l.cos_outer.clamp(-1.0, 1.0).acos());
+            LightBounds {
+                axis: Vec3::from(l.direction),
+                cos_o: l.cos_inner,
+                cos_e: (theta_o - theta_i).max(0.0).cos(),
+                ..everywhere(p, p)
+            }
+        }
+        _ => {
+            let p = Vec3::from(l.position);
+            everywhere(p, p)
+        }
+    }
+}

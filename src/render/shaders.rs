@@ -1,0 +1,103 @@
+//! WGSL composition: every shader file is embedded in the binary (the product never reads `shaders/` at
+//! run time); an entry point is an ordered list of files concatenated into one module.
+
+/// Every WGSL file, by name, embedded at compile time.
+pub const FILES: &[(&str, &str)] = &[
+    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
+    ("baked_geometry.wgsl", include_str!("../../shaders/baked_geometry.wgsl")),
+    ("scene_data.wgsl", include_str!("../../shaders/scene_data.wgsl")),
+    ("specialize.wgsl", include_str!("../../shaders/specialize.wgsl")),
+    ("rng.wgsl", include_str!("../../shaders/rng.wgsl")),
+    ("samplers.wgsl", include_str!("../../shaders/samplers.wgsl")),
+    ("warps.wgsl", include_str!("../../shaders/warps.wgsl")),
+    ("bsdf_conductor.wgsl", include_str!("../../shaders/bsdf_conductor.wgsl")),
+    ("bsdf_coated_diffuse.wgsl", include_str!("../../shaders/bsdf_coated_diffuse.wgsl")),
+    ("bsdf_dielectric.wgsl", include_str!("../../shaders/bsdf_dielectric.wgsl")),
+    ("bsdf_diffuse_transmission.wgsl", include_str!("../../shaders/bsdf_diffuse_transmission.wgsl")),
+    ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
+    ("surface.wgsl", include_str!("../../shaders/surface.wgsl")),
+    ("alpha.wgsl", include_str!("../../shaders/alpha.wgsl")),
+    ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
+    ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
+    ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
+    ("estimators.wgsl", include_str!("../../shaders/estimators.wgsl")),
+    ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
+    ("display.wgsl", include_str!("../../shaders/display.wgsl")),
+];
+
+/// Modules generated from Rust tables rather than embedded: the binding declarations (`crate::render::bindings`).
+pub const GENERATED: &[&str] = &["geometry_bindings.wgsl", "shading_bindings.wgsl"];
+
+/// The source of one embedded or generated file.
+pub fn file(name: &str) -> std::borrow::Cow<'static, str> {
+    match name {
+        "geometry_bindings.wgsl" => crate::render::bindings::geometry_wgsl().into(),
+        "shading_bindings.wgsl" => crate::render::bindings::shading_wgsl().into(),
+        _ => FILES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| (*s).into())
+            .unwrap_or_else(|| panic!("no embedded shader file named {name}")),
+    }
+}
+
+/// Concatenates files (in order) and extra source into one module, with a marker line per file so
+/// naga's error positions can be traced back.
+pub fn compose(files: &[&str], extra: &str) -> String {
+    let mut out = String::new();
+    for f in files {
+        out += &format!("// ---- {f} ----\n");
+        out += &file(f);
+        out += "\n";
+    }
+    out += extra;
+    out
+}
+
+/// `compose` with some files' text replaced (a scene's generated `scene_data.wgsl` and `baked_geometry.wgsl`).
+pub fn compose_replacing(files: &[&str], replacements: &[(&str, &str)]) -> String {
+    let mut out = String::new();
+    for f in files {
+        out += &format!("// ---- {f} ----\n");
+        match replacements.iter().find(|(n, _)| n == f) {
+            Some((_, text)) => out += text,
+            None => out += &file(f),
+        }
+        out += "\n";
+    }
+    out
+}
+
+/// Parses and validates a composed module with naga, returning the module or a readable error.
+pub fn validate(source: &str) -> Result<naga::Module, String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let mut validator =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+    validator.validate(&module).map_err(|e| e.emit_to_string(source))?;
+    Ok(module)
+}
+
+/// Builds a compute pipeline from a composed module (validated by naga first so errors are readable).
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    entry: &str,
+    constants: &[(&str, f64)],
+    layout: Option<&wgpu::PipelineLayout>,
+) -> Result<wgpu::ComputePipeline, String> {
+    validate(source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout,
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: false },
+        cache: None,
+    }))
+}

@@ -1,0 +1,6 @@
+//! What the tests use to prove the GPU right: chi-square tests of sampling routines, probe kernels that run WGSL
+//! functions on the device, and image error metrics.
+
+pub mod chi2;
+pub mod metrics;
+pub mod probe;
