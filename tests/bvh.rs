@@ -19,9 +19,8 @@ const TIE_REL: f64 = 1e-6;
 /// A ray this close (in barycentric / normalised units) to a primitive's boundary may go either way in f32.
 const EDGE_MARGIN: f64 = 1e-5;
 
-fn gpu() -> GpuContext {
-    GpuContext::new().expect("the BVH tests need a Vulkan adapter (install mesa-vulkan-drivers for lavapipe)")
-}
+mod common;
+use common::gpu;
 
 // ---------------------------------------------------------------------------------------------------------------
 // Probe kernels

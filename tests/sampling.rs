@@ -14,9 +14,11 @@ use mislab::render::settings::{EnvSampling, LightSampling, LightSelect};
 use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{EnvMap, Environment, Material, Mesh, PunctualLight, Quad, Scene, Sphere};
 use mislab::testkit::chi2::{self, Chi2Options, Chi2Report, Chi2Test, Equirect, PlaneWindow, Quadrature, SphereCap};
+use mislab::testkit::scene_probe::{BoundScene, ScenePipelines};
 use std::f64::consts::PI;
-use std::sync::{Mutex, OnceLock};
-use wgpu::util::DeviceExt;
+use std::sync::OnceLock;
+
+mod common;
 
 /// Samples per chi-square test and per integral (2²⁰ ≥ 10⁶).
 const N: u32 = 1 << 20;
@@ -254,22 +256,11 @@ enum SceneId {
     ManyLights = 4,
 }
 
-struct Bound {
-    scene: GpuScene,
-    group: wgpu::BindGroup,
-}
-
-/// Pipelines (built once: lavapipe compiles for seconds), the frame uniform and the test scenes.
+/// The probe pipelines (built once: lavapipe compiles for seconds) and the test scenes, in `SceneId` order.
 struct Harness {
     ctx: GpuContext,
-    sample: wgpu::ComputePipeline,
-    pdf: wgpu::ComputePipeline,
-    io_layout: wgpu::BindGroupLayout,
-    params: wgpu::Buffer,
-    frame_group: wgpu::BindGroup,
-    scenes: Vec<Bound>,
-    /// One dispatch at a time: the frame uniform is shared.
-    lock: Mutex<()>,
+    pipelines: ScenePipelines,
+    scenes: Vec<BoundScene>,
 }
 
 fn harness() -> &'static Harness {
@@ -277,90 +268,16 @@ fn harness() -> &'static Harness {
     H.get_or_init(Harness::new)
 }
 
-fn layout_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    }
-}
-
 impl Harness {
     fn new() -> Harness {
-        let ctx = GpuContext::new()
-            .expect("the sampling tests need a Vulkan adapter (install mesa-vulkan-drivers for lavapipe)");
-        let device = &ctx.device;
-        let ro = wgpu::BufferBindingType::Storage { read_only: true };
-        let scene_entries: Vec<_> = mislab::render::bindings::SCENE
-            .iter()
-            .map(|b| mislab::render::bindings::layout_entry(&b.binding))
-            .collect();
-        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("probe scene"),
-            entries: &scene_entries,
-        });
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("probe frame"),
-            entries: &[mislab::render::bindings::layout_entry(&mislab::render::bindings::FRAME[0])],
-        });
-        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("probe io"),
-            entries: &[
-                layout_entry(0, wgpu::BufferBindingType::Uniform),
-                layout_entry(1, wgpu::BufferBindingType::Storage { read_only: false }),
-                layout_entry(2, ro),
-            ],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("probe"),
-            bind_group_layouts: &[Some(&scene_layout), Some(&frame_layout), Some(&io_layout)],
-            immediate_size: 0,
-        });
-        let source = probe_source();
-        let sample = mislab::render::shaders::compute_pipeline(
-            device,
-            "probe_sample",
-            &source,
-            "probe_sample",
-            &[],
-            Some(&layout),
-        )
-        .unwrap();
-        let pdf =
-            mislab::render::shaders::compute_pipeline(device, "probe_pdf", &source, "probe_pdf", &[], Some(&layout))
-                .unwrap();
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("probe params"),
-            size: std::mem::size_of::<GpuFrameParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("probe frame"),
-            layout: &frame_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() }],
-        });
+        let ctx = common::gpu();
+        let pipelines = ScenePipelines::new(&ctx, &probe_source(), &["probe_sample", "probe_pdf"]).unwrap();
         let scenes =
             [lights_scene(), env_scene(pixel_map()), env_scene(map_3x2()), env_scene(hdr_map()), many_lights_scene()]
                 .into_iter()
-                .map(|s| {
-                    let scene = GpuScene::upload(&ctx, SceneData::build(&s)).expect("upload");
-                    let entries: Vec<_> = scene
-                        .buffers
-                        .iter()
-                        .enumerate()
-                        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-                        .collect();
-                    let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("probe scene"),
-                        layout: &scene_layout,
-                        entries: &entries,
-                    });
-                    Bound { scene, group }
-                })
+                .map(|s| pipelines.bind(&ctx, GpuScene::upload(&ctx, SceneData::build(&s)).expect("upload")))
                 .collect();
-        Harness { ctx, sample, pdf, io_layout, params, frame_group, scenes, lock: Mutex::new(()) }
+        Harness { ctx, pipelines, scenes }
     }
 
     fn data(&self, id: SceneId) -> &SceneData {
@@ -377,45 +294,21 @@ impl Harness {
         input: &[[f32; 4]],
         out_len: usize,
     ) -> Vec<[f32; 4]> {
-        let _guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
-        let device = &self.ctx.device;
-        self.ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(frame));
-        let job_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("probe job"),
-            contents: bytemuck::bytes_of(job),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let out = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("probe out"),
-            size: (out_len.max(1) * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let input_buf = self.ctx.storage_buffer("probe in", input, wgpu::BufferUsages::empty());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("probe io"),
-            layout: &self.io_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: job_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: input_buf.as_entire_binding() },
-            ],
-        });
-        let groups = job.count.div_ceil(64).max(1);
-        let gx = groups.min(65535);
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass =
-                enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probe"), timestamp_writes: None });
-            pass.set_pipeline(if pdf { &self.pdf } else { &self.sample });
-            pass.set_bind_group(0, &self.scenes[scene as usize].group, &[]);
-            pass.set_bind_group(1, &self.frame_group, &[]);
-            pass.set_bind_group(2, &group, &[]);
-            pass.dispatch_workgroups(gx, groups.div_ceil(gx), 1);
-        }
-        self.ctx.queue.submit([enc.finish()]);
-        self.ctx.wait().expect("device wait");
-        self.ctx.read_pod(&out, out_len).expect("readback")
+        let entry = if pdf { "probe_pdf" } else { "probe_sample" };
+        let bytes = self
+            .pipelines
+            .dispatch(
+                &self.ctx,
+                entry,
+                &self.scenes[scene as usize],
+                frame,
+                bytemuck::bytes_of(job),
+                bytemuck::cast_slice(input),
+                (out_len * 16) as u64,
+                job.count,
+            )
+            .unwrap_or_else(|e| panic!("{entry}: {e}"));
+        bytemuck::pod_collect_to_vec(&bytes)
     }
 
     /// Runs a sampling routine: per sample (output, pdf returned), (pdf function at it, distance, luminance, 0).

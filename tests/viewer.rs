@@ -3,10 +3,10 @@
 //! that the render engine's settings changed and its accumulation restarted. Plus the display pass
 //! against its CPU twin, its shared layouts, the camera controller and snapshots of the panel.
 
+mod common;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use mislab::gpu::types::GpuAccum;
-use mislab::gpu::GpuContext;
 use mislab::render::film::{linear_to_srgb, tonemap, Tonemap};
 use mislab::render::settings::*;
 use mislab::viewer::app::{settings_grid, Viewer};
@@ -272,7 +272,7 @@ fn snapshot_of_the_estimator_panel() {
 /// few ulps, and the output is quantised to 8 bits), 1e-5 relative for the sums.
 #[test]
 fn display_pass_matches_its_cpu_twin() {
-    let ctx = GpuContext::new().expect("a Vulkan adapter (lavapipe: apt-get install mesa-vulkan-drivers)");
+    let ctx = common::gpu();
     let (w, h) = (16u32, 16u32);
     let n = (w * h) as usize;
     let mut accum = vec![GpuAccum::default(); n];
