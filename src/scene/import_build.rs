@@ -209,10 +209,13 @@ impl Builder {
         }
         let mut report = vec![format!("imported from {format}:")];
         report.extend(self.imported.iter().map(|(k, n)| format!("  {n} {k}")));
-        report.push(format!("  {} materials: {}", self.descs.len(), {
+        // The materials some shape uses (a file's unused declarations and the format's unused defaults are not
+        // imported).
+        let used: std::collections::BTreeSet<usize> = self.mapped.keys().map(|k| k.0).collect();
+        report.push(format!("  {} materials used: {}", used.len(), {
             let mut kinds: BTreeMap<&str, usize> = BTreeMap::new();
-            for d in &self.descs {
-                *kinds.entry(d.kind.as_str()).or_default() += 1;
+            for &d in &used {
+                *kinds.entry(self.descs[d].kind.as_str()).or_default() += 1;
             }
             kinds.iter().map(|(k, n)| format!("{n} {k}")).collect::<Vec<_>>().join(", ")
         }));
