@@ -158,3 +158,41 @@ fn mitsuba_emitters_without_a_bsdf_reflect_nothing() {
     assert_eq!(lamp[0].base_color, glam::Vec3::ZERO, "{}", lamp[0].name);
     assert_eq!(plain[0].base_color, glam::Vec3::splat(0.5), "{}", plain[0].name);
 }
+
+/// Mitsuba 3's envmap lat-long (u = atan2(x, −z)/2π, v = acos(y)/π in the emitter's frame, then its to_world) is
+/// mislab's turned half a turn: one bright texel must land where Mitsuba's formula puts it, rotation included.
+#[test]
+fn mitsuba_envmap_orientation_follows_mitsuba() {
+    use mislab::scene::{envmap::equirect_direction, load, Environment, LoadOptions};
+    let dir = std::env::temp_dir().join(format!("mislab-xml-envmap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (w, h, bx, by) = (64u32, 32u32, 10u32, 9u32);
+    let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb(if (x, y) == (bx, by) { [255; 3] } else { [0; 3] }));
+    img.save(dir.join("dot.png")).unwrap();
+    let file = dir.join("env.xml");
+    std::fs::write(
+        &file,
+        r#"<scene version="3.0.0">
+    <emitter type="envmap">
+        <string name="filename" value="dot.png"/>
+        <transform name="to_world"><rotate y="1" angle="90"/></transform>
+    </emitter>
+</scene>"#,
+    )
+    .unwrap();
+    let s = load(file.to_str().unwrap(), &LoadOptions::default()).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let Environment::Map { map, .. } = &s.environment else { panic!("no environment map") };
+    let brightest = (0..map.texels.len()).max_by(|&a, &b| map.texels[a][0].total_cmp(&map.texels[b][0])).unwrap();
+    let (x, y) = (brightest as u32 % map.width, brightest as u32 / map.width);
+    let found = equirect_direction((x as f32 + 0.5) / map.width as f32, (y as f32 + 0.5) / map.height as f32);
+    // Mitsuba's direction of the dot's centre, in the emitter's frame and then in the world.
+    let (phi, theta) = (
+        2.0 * std::f32::consts::PI * (bx as f32 + 0.5) / w as f32,
+        std::f32::consts::PI * (by as f32 + 0.5) / h as f32,
+    );
+    let local = glam::Vec3::new(phi.sin() * theta.sin(), theta.cos(), -phi.cos() * theta.sin());
+    let expected = glam::Mat3::from_rotation_y(std::f32::consts::FRAC_PI_2) * local;
+    let degrees = found.dot(expected).clamp(-1.0, 1.0).acos().to_degrees();
+    assert!(degrees < 6.0, "the dot is {degrees:.1}° from Mitsuba's direction ({found} vs {expected})");
+}
