@@ -29,6 +29,7 @@ fn main() {
         })
         .collect();
     let (mut v_tree, mut v_power, mut count) = (0.0f64, 0.0f64, 0);
+    let mut per_point: Vec<(f64, Vec3, f64)> = Vec::new();
     let mut state = 12345u32;
     let mut rnd = || {
         state = state.wrapping_mul(747796405).wrapping_add(2891336453);
@@ -57,10 +58,20 @@ fn main() {
         let tree = m2(&|i| mislab::light_tree::pmf(&d.light_tree, d.lights[i].tree_trail, p, n) as f64);
         let power = m2(&|i| d.lights[i].pmf_power as f64);
         v_tree += tree / (total * total) - 1.0;
+        // The light that contributes most, and the share of its contribution the tree gives it.
+        let (k, fk) = f.iter().enumerate().fold((0, 0.0), |b, (i, &fi)| if fi > b.1 { (i, fi) } else { b });
+        let pk = mislab::light_tree::pmf(&d.light_tree, d.lights[k].tree_trail, p, n) as f64;
+        per_point.push((tree / (total * total) - 1.0, p, pk / (fk / total)));
         v_power += power / (total * total) - 1.0;
         count += 1;
     }
     let (vt, vp) = (v_tree / count as f64, v_power / count as f64);
+    per_point.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let q = |f: f64| per_point[((per_point.len() - 1) as f64 * f) as usize].0;
+    println!("tree per point: median {:.2}, 90% {:.2}, 99% {:.2}, max {:.2}", q(0.5), q(0.9), q(0.99), q(1.0));
+    for (v, p, ratio) in per_point.iter().rev().take(5) {
+        println!("  {v:.1} at {p}: the brightest light gets {ratio:.3} of its share of F");
+    }
     println!(
         "{name}: relative variance per sample over {count} floor points: tree {vt:.3}, power {vp:.3}, power/tree {:.2}",
         vp / vt

@@ -1,7 +1,7 @@
 //! The light tree (`--light-select tree`): a BVH over every emitter with a position — triangles, spheres, quads,
 //! point and spot lights — whose nodes carry their lights' total power, bounds and an orientation cone, so that
 //! the probability of choosing a light depends on the shading point (Conty Estevez & Kulla 2018, as pbrt-v4's
-//! `BVHLightSampler` uses it). Built here on the CPU; shaders/lights.wgsl descends it. The infinite lights
+//! `BVHLightSampler` uses it). Built here on the CPU; shaders/light_tree.wgsl descends it. The infinite lights
 //! (directional, environment) have no position: each is chosen with the same probability as the whole tree.
 //!
 //! The importance of a node seen from p with normal n has pbrt-v4's angular part (`LightBounds::Importance`):
@@ -13,7 +13,8 @@
 //! are about as large as their distance to p — near the floor of a field of lights every step down the upper
 //! levels is then close to a power split. Here each child has two importances, the angular part over the squared
 //! distance to the box's closest point (`near`) and to its farthest corner (`far`), and a child is chosen with the
-//! mean of the two normalised probabilities, as Blender Cycles' light tree does. On the many-lights scene this
+//! mean of the two normalised probabilities, after Blender Cycles' light tree (a maximal and a minimal importance,
+//! averaged). On the many-lights scene this
 //! cut the variance of the pick 5× (examples/light_tree_variance.rs measures it without a GPU).
 //!
 //! The pmf of one light from p is the product of the child probabilities on its root-to-leaf path; each light
