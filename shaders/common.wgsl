@@ -150,17 +150,24 @@ struct Light {
     _pad2: u32,
 }
 
-/// A light-tree node (src/accel/light_tree.rs): bounds, power φ, orientation cone (axis, cos θo) and emission spread cos θe
-/// of the lights below. Interior: first child next, second at `second`; leaf (second = INVALID): light `light`.
-struct LightNode {
+/// One child's bounds in a light-tree node (src/accel/light_tree.rs): bounds, power φ, orientation cone (axis, cos θo)
+/// and emission spread cos θe of the lights below it.
+struct LightChild {
     lo: vec3<f32>,
     phi: f32,
     hi: vec3<f32>,
-    second: u32,
-    axis: vec3<f32>,
     cos_o: f32,
+    axis: vec3<f32>,
     cos_e: f32,
-    light: u32,
+}
+
+/// A light-tree node: both children's bounds (one load per step down) and where they are: `next*` is a node
+/// index, or LIGHT_LEAF_BIT | a light index, or INVALID (none); bit c of `two_sided`: child c emits both ways.
+struct LightNode {
+    c0: LightChild,
+    c1: LightChild,
+    next0: u32,
+    next1: u32,
     two_sided: u32,
     count: u32,
 }

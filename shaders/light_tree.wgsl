@@ -4,7 +4,11 @@
 //
 // The lights with a position come first in the light table, `light_tree[0].count` of them; the infinite ones
 // (directional, environment) follow. Each infinite light is chosen with the probability of the whole tree:
-// 1 / (infinite + 1), or 1 / infinite without a tree.
+// 1 / (infinite + 1), or 1 / infinite without a tree. Each node holds both children's bounds, so a step down is
+// one node load.
+
+/// In a LightNode's next0/next1: the child is a leaf, the low bits its light index (light_tree::LEAF_BIT).
+const LIGHT_LEAF_BIT: u32 = 0x80000000u;
 
 fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
     if (cos_a > cos_b) { return 1.0; }
@@ -16,18 +20,23 @@ fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
     return sin_a * cos_b - cos_a * sin_b;
 }
 
-/// The importance of a node seen from p with normal n; the same arithmetic as light_tree::importance.
-fn light_node_importance(node: LightNode, p: vec3<f32>, n: vec3<f32>) -> f32 {
+/// Squared distances below this are this (light_tree::MIN_DIST2), and a box's closest distance² at least
+/// LIGHT_NEAR_CLAMP of its radius² (light_tree::NEAR_CLAMP).
+const LIGHT_MIN_DIST2: f32 = 1e-12;
+const LIGHT_NEAR_CLAMP: f32 = 1e-3;
+
+/// The importance of a child seen from p with normal n: (near, far), over the squared distance to its box's
+/// closest point and farthest corner; the same arithmetic as light_tree::importance.
+fn light_node_importance(node: LightChild, two_sided: bool, p: vec3<f32>, n: vec3<f32>) -> vec2<f32> {
     let pc = 0.5 * (node.lo + node.hi);
     let half = node.hi - node.lo;
     let r2 = 0.25 * dot(half, half);
     let to_p = p - pc;
     let dist2 = dot(to_p, to_p);
-    let d2 = max(dist2, r2);
     var wi = vec3<f32>(0.0, 0.0, 1.0);
     if (dist2 > 0.0) { wi = to_p / sqrt(dist2); }
     var cos_w = dot(node.axis, wi);
-    if (node.two_sided != 0u) { cos_w = abs(cos_w); }
+    if (two_sided) { cos_w = abs(cos_w); }
     let sin_w = sqrt(max(1.0 - cos_w * cos_w, 0.0));
     var sin_b = 0.0;
     var cos_b = -1.0;
@@ -40,25 +49,29 @@ fn light_node_importance(node: LightNode, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
     let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
     let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-    if (cos_p <= node.cos_e) { return 0.0; }
-    var imp = node.phi * cos_p / d2;
+    if (cos_p <= node.cos_e) { return vec2<f32>(0.0); }
+    var a = node.phi * cos_p;
     if (any(n != vec3<f32>(0.0))) {
         let cos_i = abs(dot(wi, n));
         let sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
-        imp *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+        a *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
     }
-    return max(imp, 0.0);
+    a = max(a, 0.0);
+    let floor_d2 = max(LIGHT_NEAR_CLAMP * r2, LIGHT_MIN_DIST2);
+    let dn = p - clamp(p, node.lo, node.hi);
+    let df = p - select(node.lo, node.hi, p < pc);
+    return vec2<f32>(a / max(dot(dn, dn), floor_d2), a / max(dot(df, df), floor_d2));
 }
 
-/// The probability of descending into the first child of `node` (by power where neither child has importance,
-/// as light_tree::first_child_probability).
-fn tree_first_child_probability(node: LightNode, node_index: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let c0 = light_tree[node_index + 1u];
-    let c1 = light_tree[node.second];
-    let i0 = light_node_importance(c0, p, n);
-    let i1 = light_node_importance(c1, p, n);
-    if (i0 + i1 > 0.0) { return i0 / (i0 + i1); }
-    if (c0.phi + c1.phi > 0.0) { return c0.phi / (c0.phi + c1.phi); }
+/// The probability of descending into the first child of `node`: the mean of the near and far importances'
+/// shares, by power where neither child has importance (as light_tree::first_child_probability).
+fn tree_first_child_probability(node: LightNode, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    if (node.next1 == INVALID) { return 1.0; }
+    let i0 = light_node_importance(node.c0, (node.two_sided & 1u) != 0u, p, n);
+    let i1 = light_node_importance(node.c1, (node.two_sided & 2u) != 0u, p, n);
+    let sum = i0 + i1;
+    if (sum.x > 0.0 && sum.y > 0.0) { return 0.5 * (i0.x / sum.x + i0.y / sum.y); }
+    if (node.c0.phi + node.c1.phi > 0.0) { return node.c0.phi / (node.c0.phi + node.c1.phi); }
     return 0.5;
 }
 
@@ -84,20 +97,20 @@ fn tree_select_light(u_in: f32, p: vec3<f32>, n: vec3<f32>) -> u32 {
         return t.bounded + k;
     }
     u = min(u / t.p_tree, ONE_MINUS_EPSILON);
-    var i = 0u;
-    var node = light_tree[0];
-    for (var depth = 0u; depth < 32u && node.second != INVALID; depth += 1u) {
-        let p0 = tree_first_child_probability(node, i, p, n);
+    var next = 0u;
+    for (var depth = 0u; depth < 32u; depth += 1u) {
+        let node = light_tree[next];
+        let p0 = tree_first_child_probability(node, p, n);
         if (u < p0) {
             u = min(u / p0, ONE_MINUS_EPSILON);
-            i = i + 1u;
+            next = node.next0;
         } else {
             u = min((u - p0) / (1.0 - p0), ONE_MINUS_EPSILON);
-            i = node.second;
+            next = node.next1;
         }
-        node = light_tree[i];
+        if ((next & LIGHT_LEAF_BIT) != 0u) { break; }
     }
-    return node.light;
+    return next & ~LIGHT_LEAF_BIT;
 }
 
 fn tree_light_pmf(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
@@ -105,19 +118,19 @@ fn tree_light_pmf(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     if (light >= t.bounded) { return (1.0 - t.p_tree) / f32(t.infinite); }
     var trail = scene_light(light).tree_trail;
     var pmf = t.p_tree;
-    var i = 0u;
-    var node = light_tree[0];
-    for (var depth = 0u; depth < 32u && node.second != INVALID; depth += 1u) {
-        let p0 = tree_first_child_probability(node, i, p, n);
+    var next = 0u;
+    for (var depth = 0u; depth < 32u; depth += 1u) {
+        let node = light_tree[next];
+        let p0 = tree_first_child_probability(node, p, n);
         if ((trail & 1u) == 0u) {
             pmf *= p0;
-            i = i + 1u;
+            next = node.next0;
         } else {
             pmf *= 1.0 - p0;
-            i = node.second;
+            next = node.next1;
         }
         trail = trail >> 1u;
-        node = light_tree[i];
+        if ((next & LIGHT_LEAF_BIT) != 0u) { break; }
     }
     return pmf;
 }

@@ -88,12 +88,8 @@ fn shared_structs_match() {
             _pad2
         ]
     );
-    check!(
-        m,
-        "LightNode",
-        mislab::accel::light_tree::GpuLightNode,
-        [lo, phi, hi, second, axis, cos_o, cos_e, light, two_sided, count]
-    );
+    check!(m, "LightChild", mislab::accel::light_tree::GpuLightChild, [lo, phi, hi, cos_o, axis, cos_e]);
+    check!(m, "LightNode", mislab::accel::light_tree::GpuLightNode, [c0, c1, next0, next1, two_sided, count]);
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
     check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, _pad0]);
     check!(m, "Accum", GpuAccum, [mean, count, m2, nonfinite]);
@@ -202,6 +198,9 @@ fn tag_constants_match() {
         ("WRAP_CLAMP", WRAP_CLAMP),
         ("WRAP_MIRROR", WRAP_MIRROR),
         ("INVALID", INVALID),
+        ("LIGHT_LEAF_BIT", mislab::accel::light_tree::LEAF_BIT),
+        // The light tree's empty child is the shader's INVALID.
+        ("INVALID", mislab::accel::light_tree::EMPTY),
     ] {
         assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");
     }

@@ -1,15 +1,21 @@
 //! The light tree (`--light-select tree`): a BVH over every emitter with a position — triangles, spheres, quads,
 //! point and spot lights — whose nodes carry their lights' total power, bounds and an orientation cone, so that
 //! the probability of choosing a light depends on the shading point (Conty Estevez & Kulla 2018, as pbrt-v4's
-//! `BVHLightSampler` uses it). Built here on the CPU; shaders/lights.wgsl descends it. The infinite lights
+//! `BVHLightSampler` uses it). Built here on the CPU; shaders/light_tree.wgsl descends it. The infinite lights
 //! (directional, environment) have no position: each is chosen with the same probability as the whole tree.
 //!
-//! The importance of a node seen from p with normal n (pbrt-v4's `LightBounds::Importance`):
-//! φ · cos θ' / d² · cos θ'ᵢ, where d is the distance to the bounds' centre (at least their radius), θ' the angle
-//! between the cone's axis and the direction to p less the cone's spread θo and the angle θb the bounds subtend
-//! (0 past the emission spread θe), and θ'ᵢ the angle between n and the direction to the bounds less θb. It
-//! bounds the light's contribution from above up to a factor, and is 0 only where every light below emits
-//! nothing towards p, so no light that can reach p gets probability 0.
+//! The importance of a node seen from p with normal n has pbrt-v4's angular part (`LightBounds::Importance`):
+//! φ · cos θ' · cos θ'ᵢ, where θ' is the angle between the cone's axis and the direction to p less the cone's
+//! spread θo and the angle θb the bounds' bounding sphere subtends (0 past the emission spread θe), and θ'ᵢ the
+//! angle between n and the direction to the bounds less θb. It is 0 only where every light below emits nothing
+//! towards p, so no light that can reach p gets probability 0. The distance part differs: pbrt-v4 divides by the
+//! squared distance to the box's centre (at least its radius²), which cannot tell apart two siblings whose boxes
+//! are about as large as their distance to p — near the floor of a field of lights every step down the upper
+//! levels is then close to a power split. Here each child has two importances, the angular part over the squared
+//! distance to the box's closest point (`near`) and to its farthest corner (`far`), and a child is chosen with the
+//! mean of the two normalised probabilities, after Blender Cycles' light tree (a maximal and a minimal importance,
+//! averaged). On the many-lights scene this
+//! cut the variance of the pick 5× (examples/light_tree_variance.rs measures it without a GPU).
 //!
 //! The pmf of one light from p is the product of the child probabilities on its root-to-leaf path; each light
 //! stores that path as bits (`tree_trail`, bit k = the second child at depth k), so the pmf of a light found by a
@@ -19,11 +25,16 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-/// Marks a leaf in `GpuLightNode::second`.
-pub const LEAF: u32 = 0xffff_ffff;
+/// In a child reference (`GpuLightNode::next`): the child is a leaf and the low bits are its light-table index.
+pub const LEAF_BIT: u32 = 0x8000_0000;
+/// A child reference that refers to nothing: the second child of a root over a single light.
+pub const EMPTY: u32 = 0xffff_ffff;
 /// Trail bits: a leaf is at most this deep. The heuristic splits a node only while its lights still fit below it
 /// when split at the median from there on (depth + ⌈log2 n⌉ < 32).
 const MAX_DEPTH: u32 = 32;
+/// The closest distance² to a box that contains p is this fraction of its radius²: finite, and large enough
+/// that a box around p does not take every sample from its sibling.
+const NEAR_CLAMP: f32 = 1e-3;
 /// Buckets per axis of the split heuristic.
 const BUCKETS: usize = 12;
 
@@ -41,21 +52,31 @@ pub struct LightBounds {
     pub two_sided: bool,
 }
 
-/// One node as the GPU reads it (WGSL `LightNode`). Interior nodes: the first child is the next node, the second at
-/// `second`. Leaves: `second` = [`LEAF`] and `light` is the light's index in the light table.
+/// One child's bounds as its parent stores them (WGSL `LightChild`): what the importance needs.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuLightNode {
+pub struct GpuLightChild {
     pub lo: [f32; 3],
     pub phi: f32,
     pub hi: [f32; 3],
-    pub second: u32,
-    pub axis: [f32; 3],
     pub cos_o: f32,
+    pub axis: [f32; 3],
     pub cos_e: f32,
-    pub light: u32,
+}
+
+/// One interior node as the GPU reads it (WGSL `LightNode`): both children's bounds, so that one load gives both
+/// importances of a step down (lavapipe pays per storage load: docs/profile-bvh.md), and where each child is:
+/// `next[c]` is a node index, or [`LEAF_BIT`] | the light's index in the light table, or [`EMPTY`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuLightNode {
+    pub c0: GpuLightChild,
+    pub c1: GpuLightChild,
+    pub next0: u32,
+    pub next1: u32,
+    /// Bit c: child c emits from both sides.
     pub two_sided: u32,
-    /// Lights below this node.
+    /// Lights below this node (the root's: how many lights of the table the tree covers).
     pub count: u32,
 }
 
@@ -93,18 +114,14 @@ impl LightBounds {
         0.5 * (self.lo + self.hi)
     }
 
-    fn to_gpu(self, second: u32, light: u32, count: u32) -> GpuLightNode {
-        GpuLightNode {
+    fn to_child(self) -> GpuLightChild {
+        GpuLightChild {
             lo: self.lo.into(),
             phi: self.phi,
             hi: self.hi.into(),
-            second,
-            axis: self.axis.into(),
             cos_o: self.cos_o,
+            axis: self.axis.into(),
             cos_e: self.cos_e,
-            light,
-            two_sided: self.two_sided as u32,
-            count,
         }
     }
 }
@@ -153,25 +170,29 @@ fn safe_sqrt(x: f32) -> f32 {
     x.max(0.0).sqrt()
 }
 
-/// The importance of a node seen from p with surface normal n (module docs). The same arithmetic, in the same
-/// order, as `light_node_importance` in shaders/lights.wgsl (f32 both), so CPU and GPU pmfs agree closely.
-pub fn importance(node: &GpuLightNode, p: Vec3, n: Vec3) -> f32 {
+/// Squared distances below this are this (a shading point on a point light).
+const MIN_DIST2: f32 = 1e-12;
+
+/// The importance of a child seen from p with surface normal n (module docs): (near, far), with the closest and
+/// the farthest distance to its box. The same arithmetic, in the same order, as `light_node_importance` in
+/// shaders/light_tree.wgsl (f32 both), so CPU and GPU pmfs agree closely.
+pub fn importance(node: &GpuLightChild, two_sided: bool, p: Vec3, n: Vec3) -> (f32, f32) {
     let (lo, hi) = (Vec3::from(node.lo), Vec3::from(node.hi));
     let pc = 0.5 * (lo + hi);
     let r2 = 0.25 * (hi - lo).length_squared();
-    let d2 = (p - pc).length_squared().max(r2);
     let to_p = p - pc;
-    let wi = if to_p.length_squared() > 0.0 { to_p.normalize() } else { Vec3::Z };
+    let dist2 = to_p.length_squared();
+    let wi = if dist2 > 0.0 { to_p / dist2.sqrt() } else { Vec3::Z };
     let mut cos_w = Vec3::from(node.axis).dot(wi);
-    if node.two_sided != 0 {
+    if two_sided {
         cos_w = cos_w.abs();
     }
     let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
     // The cone of directions from p to the bounds' bounding sphere.
-    let (sin_b, cos_b) = if (p - pc).length_squared() < r2 {
+    let (sin_b, cos_b) = if dist2 < r2 {
         (0.0, -1.0)
     } else {
-        let s2 = r2 / (p - pc).length_squared();
+        let s2 = r2 / dist2;
         (safe_sqrt(s2), safe_sqrt(1.0 - s2))
     };
     let sin_o = safe_sqrt(1.0 - node.cos_o * node.cos_o);
@@ -179,60 +200,89 @@ pub fn importance(node: &GpuLightNode, p: Vec3, n: Vec3) -> f32 {
     let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, node.cos_o);
     let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
     if cos_p <= node.cos_e {
-        return 0.0;
+        return (0.0, 0.0);
     }
-    let mut imp = node.phi * cos_p / d2;
+    let mut a = node.phi * cos_p;
     if n != Vec3::ZERO {
         let cos_i = wi.dot(n).abs();
         let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
-        imp *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+        a *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
     }
-    imp.max(0.0)
+    let a = a.max(0.0);
+    let floor = (NEAR_CLAMP * r2).max(MIN_DIST2);
+    let near = (p - p.clamp(lo, hi)).length_squared().max(floor);
+    let far = (p - Vec3::select(p.cmplt(pc), hi, lo)).length_squared().max(floor);
+    (a / near, a / far)
 }
 
-/// The probability of descending into the first of two children: by importance, or by power where neither has
+/// The probability of descending into the first child of `node`: by importance, or by power where neither has
 /// any (conservative bounds can give a node importance whose children both have none: descending by power
 /// there keeps Σ pmf = 1 at every point, at the cost of a wasted sample where no light reaches p anyway).
-pub fn first_child_probability(c0: &GpuLightNode, c1: &GpuLightNode, p: Vec3, n: Vec3) -> f32 {
-    let (i0, i1) = (importance(c0, p, n), importance(c1, p, n));
-    if i0 + i1 > 0.0 {
-        return i0 / (i0 + i1);
+pub fn first_child_probability(node: &GpuLightNode, p: Vec3, n: Vec3) -> f32 {
+    if node.next1 == EMPTY {
+        return 1.0;
     }
-    if c0.phi + c1.phi > 0.0 {
-        return c0.phi / (c0.phi + c1.phi);
+    let (n0, f0) = importance(&node.c0, node.two_sided & 1 != 0, p, n);
+    let (n1, f1) = importance(&node.c1, node.two_sided & 2 != 0, p, n);
+    if n0 + n1 > 0.0 && f0 + f1 > 0.0 {
+        return 0.5 * (n0 / (n0 + n1) + f0 / (f0 + f1));
+    }
+    if node.c0.phi + node.c1.phi > 0.0 {
+        return node.c0.phi / (node.c0.phi + node.c1.phi);
     }
     0.5
 }
 
 impl LightTree {
     /// Builds the tree over `lights` (index k of the input = `light_index[k]` in the light table), every one of
-    /// them: the root's `count` is how many lights of the table the tree covers.
+    /// them: the root's `count` is how many lights of the table the tree covers. A single light gets a root
+    /// whose second child is [`EMPTY`].
     pub fn build(lights: &[LightBounds], light_index: &[u32]) -> LightTree {
         let mut tree = LightTree { nodes: vec![], trails: vec![0; lights.len()] };
         let mut items: Vec<usize> = (0..lights.len()).collect();
-        if !items.is_empty() {
-            tree.build_node(lights, light_index, &mut items, 0, 0);
+        match items.len() {
+            0 => {}
+            1 => {
+                let c0 = lights[0].to_child();
+                let two_sided = lights[0].two_sided as u32;
+                let next0 = LEAF_BIT | light_index[0];
+                tree.nodes.push(GpuLightNode { c0, next0, next1: EMPTY, two_sided, count: 1, ..Default::default() });
+            }
+            _ => {
+                tree.build_node(lights, light_index, &mut items, 0, 0);
+            }
         }
         tree
     }
 
-    fn build_node(&mut self, lights: &[LightBounds], index: &[u32], items: &mut [usize], depth: u32, trail: u32) {
-        let bounds = items.iter().skip(1).fold(lights[items[0]], |b, &k| b.union(&lights[k]));
-        let me = self.nodes.len();
+    /// Builds the subtree over `items` at `depth` and returns its bounds and its reference (a node index, or a
+    /// leaf's [`LEAF_BIT`] | light index).
+    fn build_node(
+        &mut self,
+        lights: &[LightBounds],
+        index: &[u32],
+        items: &mut [usize],
+        depth: u32,
+        trail: u32,
+    ) -> (LightBounds, u32) {
         if items.len() == 1 {
             let k = items[0];
             self.trails[k] = trail;
-            self.nodes.push(bounds.to_gpu(LEAF, index[k], 1));
-            return;
+            return (lights[k], LEAF_BIT | index[k]);
         }
-        self.nodes.push(bounds.to_gpu(0, 0, items.len() as u32));
+        let bounds = items.iter().skip(1).fold(lights[items[0]], |b, &k| b.union(&lights[k]));
+        let me = self.nodes.len();
+        self.nodes.push(GpuLightNode { count: items.len() as u32, ..Default::default() });
         let fits = depth + items.len().next_power_of_two().trailing_zeros() < MAX_DEPTH;
         let mid = if fits { split_saoh(lights, items, &bounds) } else { None };
         let mid = mid.unwrap_or_else(|| split_median(lights, items, &bounds));
         let (a, b) = items.split_at_mut(mid);
-        self.build_node(lights, index, a, depth + 1, trail);
-        self.nodes[me].second = self.nodes.len() as u32;
-        self.build_node(lights, index, b, depth + 1, trail | (1u32 << depth));
+        let (b0, r0) = self.build_node(lights, index, a, depth + 1, trail);
+        let (b1, r1) = self.build_node(lights, index, b, depth + 1, trail | (1u32 << depth));
+        let node = &mut self.nodes[me];
+        (node.c0, node.c1, node.next0, node.next1) = (b0.to_child(), b1.to_child(), r0, r1);
+        node.two_sided = b0.two_sided as u32 | (b1.two_sided as u32) << 1;
+        (bounds, me as u32)
     }
 
     /// The probability that the tree picks its light with input index k from (p, n). f32 like the GPU.
@@ -240,19 +290,20 @@ impl LightTree {
         pmf(&self.nodes, self.trails[k], p, n)
     }
 
-    /// Every leaf's light-table index, with its input index, for tests.
+    /// Every leaf's light-table index, for tests.
     pub fn leaves(&self) -> Vec<u32> {
-        self.nodes.iter().filter(|n| n.second == LEAF).map(|n| n.light).collect()
+        let refs = self.nodes.iter().flat_map(|n| [n.next0, n.next1]);
+        refs.filter(|&r| r != EMPTY && r & LEAF_BIT != 0).map(|r| r & !LEAF_BIT).collect()
     }
 
-    /// Depth of the deepest leaf.
+    /// Depth of the deepest leaf (the number of steps down to it).
     pub fn depth(&self) -> u32 {
-        fn walk(t: &LightTree, i: usize) -> u32 {
-            let n = &t.nodes[i];
-            if n.second == LEAF {
+        fn walk(t: &LightTree, r: u32) -> u32 {
+            if r == EMPTY || r & LEAF_BIT != 0 {
                 return 0;
             }
-            1 + walk(t, i + 1).max(walk(t, n.second as usize))
+            let n = &t.nodes[r as usize];
+            1 + walk(t, n.next0).max(walk(t, n.next1))
         }
         if self.nodes.is_empty() {
             0
@@ -264,23 +315,27 @@ impl LightTree {
 
 /// The probability that a walk down `nodes` from (p, n) ends at the leaf with root-to-leaf path `trail`: the
 /// product of the child probabilities on the way (0 for an empty tree). The same walk as `tree_light_pmf` in
-/// shaders/lights.wgsl, which also includes the probability of choosing the tree over the infinite lights.
+/// shaders/light_tree.wgsl, which also includes the probability of choosing the tree over the infinite lights.
 pub fn pmf(nodes: &[GpuLightNode], mut trail: u32, p: Vec3, n: Vec3) -> f32 {
     if nodes.is_empty() {
         return 0.0;
     }
-    let mut i = 0usize;
+    let mut r = 0u32;
     let mut pmf = 1.0f32;
-    while nodes[i].second != LEAF {
-        let p0 = first_child_probability(&nodes[i + 1], &nodes[nodes[i].second as usize], p, n);
+    for _ in 0..MAX_DEPTH {
+        let node = &nodes[r as usize];
+        let p0 = first_child_probability(node, p, n);
         if trail & 1 == 0 {
             pmf *= p0;
-            i += 1;
+            r = node.next0;
         } else {
             pmf *= 1.0 - p0;
-            i = nodes[i].second as usize;
+            r = node.next1;
         }
         trail >>= 1;
+        if r == EMPTY || r & LEAF_BIT != 0 {
+            break;
+        }
     }
     pmf
 }
@@ -304,41 +359,34 @@ fn saoh_cost(b: &LightBounds, extent: Vec3, axis: usize) -> f32 {
 /// The best bucket split over the three axes, or None (all centroids equal, or no split is better than a leaf
 /// chain): items are partitioned in place and the first part's length returned.
 fn split_saoh(lights: &[LightBounds], items: &mut [usize], bounds: &LightBounds) -> Option<usize> {
-    let (clo, chi) = items.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), &k| {
-        let c = lights[k].centroid();
-        (lo.min(c), hi.max(c))
-    });
+    let nb = BUCKETS;
+    let key = |k: usize, dim: usize| lights[k].centroid()[dim];
     let extent = bounds.hi - bounds.lo;
-    let mut best: Option<(f32, usize, usize)> = None;
-    for axis in 0..3 {
-        let span = chi[axis] - clo[axis];
+    let mut best: Option<(f32, usize, usize, f32, f32)> = None;
+    for dim in 0..3 {
+        let (klo, khi) =
+            items.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &k| (lo.min(key(k, dim)), hi.max(key(k, dim))));
+        let span = khi - klo;
         if !(span > 0.0) {
             continue;
         }
-        let bucket_of = |k: usize| {
-            let t = (lights[k].centroid()[axis] - clo[axis]) / span;
-            ((t * BUCKETS as f32) as usize).min(BUCKETS - 1)
-        };
-        let mut buckets: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
+        let bucket_of = |k: usize| (((key(k, dim) - klo) / span * nb as f32) as usize).min(nb - 1);
+        let mut buckets: Vec<Option<LightBounds>> = vec![None; nb];
         for &k in items.iter() {
             let b = bucket_of(k);
             buckets[b] = Some(buckets[b].map_or(lights[k], |x| x.union(&lights[k])));
         }
-        for split in 1..BUCKETS {
+        for split in 1..nb {
             let merge = |r: std::ops::Range<usize>| r.filter_map(|i| buckets[i]).reduce(|a, b| a.union(&b));
-            let (Some(a), Some(b)) = (merge(0..split), merge(split..BUCKETS)) else { continue };
-            let cost = saoh_cost(&a, extent, axis) + saoh_cost(&b, extent, axis);
-            if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, split));
+            let (Some(a), Some(b)) = (merge(0..split), merge(split..nb)) else { continue };
+            let cost = saoh_cost(&a, extent, dim) + saoh_cost(&b, extent, dim);
+            if best.is_none_or(|(c, ..)| cost < c) {
+                best = Some((cost, dim, split, klo, span));
             }
         }
     }
-    let (_, axis, split) = best?;
-    let span = chi[axis] - clo[axis];
-    let left = |k: &usize| {
-        let t = (lights[*k].centroid()[axis] - clo[axis]) / span;
-        ((t * BUCKETS as f32) as usize).min(BUCKETS - 1) < split
-    };
+    let (_, dim, split, klo, span) = best?;
+    let left = |k: &usize| ((((key(*k, dim) - klo) / span * nb as f32) as usize).min(nb - 1)) < split;
     let mid = partition_in_place(items, left);
     (mid > 0 && mid < items.len()).then_some(mid)
 }
