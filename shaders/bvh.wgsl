@@ -235,16 +235,15 @@ fn bvh_all_lanes(b: bool) -> bool {
     return b; // BVH_VOTE
 }
 
-/// Pops the nearest stacked entry not beyond `t` (entries entered beyond the closest hit are dropped), or INVALID.
+/// Pops the top stack entry: its reference, or INVALID where it was entered beyond `t` (a closer hit has been
+/// found since; the next step pops again). One pop per call, no loop: on lavapipe every loop in a step's body
+/// costs at least one pass whether or not a lane needs it.
 fn bvh_pop(base: u32, sp: ptr<function, u32>, t: f32) -> u32 {
-    var next = INVALID;
-    for (var k = 0u; k < BVH_STACK_SIZE && next == INVALID && *sp > 0u; k++) {
-        *sp -= 1u;
-        if bvh_stack_t[base + *sp] <= t {
-            next = bvh_stack_node[base + *sp];
-        }
+    if *sp == 0u {
+        return INVALID;
     }
-    return next;
+    *sp -= 1u;
+    return select(INVALID, bvh_stack_node[base + *sp], bvh_stack_t[base + *sp] <= t);
 }
 
 /// Stack-based BVH2 traversal shared by trace_closest and trace_any: Aila & Laine 2009's while-while loop with
@@ -276,35 +275,42 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;
     var sp = 0u;
-    var cur = 0u;        // the next interior node to visit, or a leaf waiting behind `leaf`, or INVALID
+    var cur = 0u;        // the next interior node to visit, a leaf waiting behind `leaf`, or INVALID: pop
     var leaf = INVALID;  // the postponed leaf: its next primitive and how many follow
     let max_steps = arrayLength(&bvh_nodes) + 1u;
-    for (var round = 0u; round < max_steps && (cur != INVALID || leaf != INVALID); round++) {
-        for (var step = 0u; step < max_steps && bvh_is_interior(cur); step++) {
-            let node = bvh_nodes[cur];
-            let l_valid = node.l_count > 0u || node.l_first != INVALID;
-            let r_valid = node.r_count > 0u || node.r_first != INVALID;
-            let tl = select(F32_MAX, ray_box_entry(r, node.lmin, node.lmax, hit.t), l_valid);
-            let tr = select(F32_MAX, ray_box_entry(r, node.rmin, node.rmax, hit.t), r_valid);
-            let lref = bvh_child_ref(node.l_first, node.l_count);
-            let rref = bvh_child_ref(node.r_first, node.r_count);
-            let right_first = tr < tl;
-            let near_t = select(tl, tr, right_first);
-            let far_t = select(tr, tl, right_first);
-            if far_t != F32_MAX && sp < BVH_STACK_SIZE {
-                bvh_stack_node[base + sp] = select(rref, lref, right_first);
-                bvh_stack_t[base + sp] = far_t;
-                sp += 1u;
+    for (var round = 0u; round < max_steps && (cur != INVALID || leaf != INVALID || sp > 0u); round++) {
+        for (var step = 0u; step < 2u * max_steps && (bvh_is_interior(cur) || (cur == INVALID && sp > 0u)); step++) {
+            var next = INVALID;
+            if cur != INVALID {
+                let node = bvh_nodes[cur];
+                let l_valid = node.l_count > 0u || node.l_first != INVALID;
+                let r_valid = node.r_count > 0u || node.r_first != INVALID;
+                let tl = select(F32_MAX, ray_box_entry(r, node.lmin, node.lmax, hit.t), l_valid);
+                let tr = select(F32_MAX, ray_box_entry(r, node.rmin, node.rmax, hit.t), r_valid);
+                let lref = bvh_child_ref(node.l_first, node.l_count);
+                let rref = bvh_child_ref(node.r_first, node.r_count);
+                let right_first = tr < tl;
+                let near_t = select(tl, tr, right_first);
+                let far_t = select(tr, tl, right_first);
+                if far_t != F32_MAX && sp < BVH_STACK_SIZE {
+                    bvh_stack_node[base + sp] = select(rref, lref, right_first);
+                    bvh_stack_t[base + sp] = far_t;
+                    sp += 1u;
+                }
+                next = select(INVALID, select(lref, rref, right_first), near_t != F32_MAX);
+                if bvh_is_leaf(next) && leaf == INVALID {
+                    leaf = next;
+                    next = INVALID;
+                }
             }
-            if near_t != F32_MAX {
-                cur = select(lref, rref, right_first);
-            } else {
-                cur = bvh_pop(base, &sp, hit.t);
+            if next == INVALID {
+                next = bvh_pop(base, &sp, hit.t);
+                if bvh_is_leaf(next) && leaf == INVALID {
+                    leaf = next;
+                    next = INVALID;
+                }
             }
-            if bvh_is_leaf(cur) && leaf == INVALID {
-                leaf = cur;
-                cur = bvh_pop(base, &sp, hit.t);
-            }
+            cur = next;
             if bvh_all_lanes(leaf != INVALID) {
                 break;
             }
@@ -336,7 +342,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
                 leaf += 1u - BVH_LEAF_COUNT_ONE;
             } else if bvh_is_leaf(cur) {
                 leaf = cur;
-                cur = bvh_pop(base, &sp, hit.t);
+                cur = INVALID;
             } else {
                 leaf = INVALID;
             }
