@@ -32,8 +32,6 @@ var<private> bvh_lane: u32;
 fn bvh_set_lane(local_index: u32) {
     bvh_lane = min(local_index, BVH_LANES - 1u);
 }
-/// Upper bound on one leaf's loop (the builder makes ≤ 4); guards against a corrupt count.
-const BVH_MAX_LEAF_PRIMS: u32 = 255u;
 /// Conservative far-distance scale for the slab test, 1 + 2γ₃ rounded up (Ize 2013, "Robust BVH Ray Traversal",
 /// JCGT 2(2)): the rounded slab distances then never reject a box the exact ray passes through.
 const BVH_SLAB_FAR_SCALE: f32 = 1.0000004;
@@ -211,10 +209,50 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
     }
 }
 
-/// Stack-based BVH2 traversal shared by trace_closest and trace_any. Children are visited near-first by entry
-/// distance; a leaf child is intersected in its parent's step, an interior far child is pushed with its entry
-/// distance and skipped on pop if a closer hit has been found since. Each step consumes one interior node and
-/// every node is visited at most once, so the node count bounds the loop.
+/// A child reference in one word, as the traversal stack and the leaf queue hold it: an interior node's index
+/// (bit 31 clear), or BVH_LEAF | (count − 1) << 28 | first for a leaf of 1..=8 primitives (src/accel/bvh.rs makes ≤ 4;
+/// `first` < 2^28 always holds: the node and vertex bindings cannot hold that many). INVALID = none.
+const BVH_LEAF: u32 = 0x80000000u;
+const BVH_LEAF_COUNT_ONE: u32 = 0x10000000u;
+const BVH_LEAF_FIRST_MASK: u32 = 0x0fffffffu;
+
+fn bvh_child_ref(first: u32, count: u32) -> u32 {
+    return select(first, BVH_LEAF | ((min(count, 8u) - 1u) << 28u) | (first & BVH_LEAF_FIRST_MASK), count > 0u);
+}
+
+fn bvh_is_interior(r: u32) -> bool {
+    return (r & BVH_LEAF) == 0u;
+}
+
+fn bvh_is_leaf(r: u32) -> bool {
+    return (r & BVH_LEAF) != 0u && r != INVALID;
+}
+
+/// Whether `b` holds on every active lane of this SIMD group: the vote of speculative traversal. Devices with
+/// subgroup operations get `subgroupAll` here (src/render/shaders.rs `for_device`); without them each lane votes alone,
+/// which makes the traversal a plain while-while loop.
+fn bvh_all_lanes(b: bool) -> bool {
+    return b; // BVH_VOTE
+}
+
+/// Pops the top stack entry: its reference, or INVALID where it was entered beyond `t` (a closer hit has been
+/// found since; the next step pops again). One pop per call, no loop: on lavapipe every loop in a step's body
+/// costs at least one pass whether or not a lane needs it.
+fn bvh_pop(base: u32, sp: ptr<function, u32>, t: f32) -> u32 {
+    if *sp == 0u {
+        return INVALID;
+    }
+    *sp -= 1u;
+    return select(INVALID, bvh_stack_node[base + *sp], bvh_stack_t[base + *sp] <= t);
+}
+
+/// Stack-based BVH2 traversal shared by trace_closest and trace_any: Aila & Laine 2009's while-while loop with
+/// speculative traversal. Lavapipe (and a GPU) runs a SIMD group's lanes in lockstep, executes a loop until its
+/// last lane is done and a branch for any lane that takes it; in a loop that did a node step and a leaf's
+/// primitive tests in the same iteration, every step paid for the leaf loop whenever one lane of 8 had a leaf.
+/// Here an inner loop only visits interior nodes (near child first by entry distance, the far one pushed) and a
+/// lane that reaches a leaf postpones it and keeps traversing until every lane has one; then a second loop tests
+/// the postponed leaves' primitives, one per iteration, with all lanes busy. Node visits bound both loops.
 fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var hit = Hit(t_max, INVALID, 0.0, 0.0);
     // NaN/Inf rays, a zero direction or a NaN or non-positive t_max can hit nothing.
@@ -229,82 +267,86 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
         }
         return baked_traverse(r, hit, skip);
     }
+    // In a triangle-only scene prim_refs[j] == j (src/accel/bvh.rs into_leaf_order): a leaf's triangles are read
+    // directly, with no prim_refs load and no switch on the kind; storage loads dominate a BVH sample on
+    // lavapipe (docs/profile-bvh.md). Chosen per pipeline, not per leaf: a branch between the two paths costs
+    // lavapipe both (measured 13 % slower than always reading prim_refs).
+    let tri_run = HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS;
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;
     var sp = 0u;
-    var node_index = 0u;
+    var cur = 0u;        // the next interior node to visit, a leaf waiting behind `leaf`, or INVALID: pop
+    var leaf = INVALID;  // the postponed leaf: its next primitive and how many follow
     let max_steps = arrayLength(&bvh_nodes) + 1u;
-    for (var step = 0u; step < max_steps; step++) {
-        let node = bvh_nodes[node_index];
-        let l_valid = node.l_count > 0u || node.l_first != INVALID;
-        let r_valid = node.r_count > 0u || node.r_first != INVALID;
-        var tl = ray_box_entry(r, node.lmin, node.lmax, hit.t);
-        var tr = ray_box_entry(r, node.rmin, node.rmax, hit.t);
-        tl = select(F32_MAX, tl, l_valid);
-        tr = select(F32_MAX, tr, r_valid);
-        let right_first = tr < tl;
-        let near_t = select(tl, tr, right_first);
-        let far_t = select(tr, tl, right_first);
-        let near_first = select(node.l_first, node.r_first, right_first);
-        let near_count = select(node.l_count, node.r_count, right_first);
-        let far_first = select(node.r_first, node.l_first, right_first);
-        let far_count = select(node.r_count, node.l_count, right_first);
-
-        var next = INVALID;
-        for (var c = 0u; c < 2u; c++) {
-            let ct = select(far_t, near_t, c == 0u);
-            let first = select(far_first, near_first, c == 0u);
-            let count = select(far_count, near_count, c == 0u);
-            // Re-test against hit.t: the near leaf may have shortened the ray.
-            if !(ct <= hit.t) || ct == F32_MAX {
-                continue;
-            }
-            if count > 0u {
-                // In a triangle-only scene prim_refs[j] == j (src/accel/bvh.rs into_leaf_order): a leaf's triangles are
-                // read directly, with no prim_refs load and no switch on the kind; storage loads dominate a BVH
-                // sample on lavapipe (docs/profile-bvh.md). Chosen per pipeline, not per leaf: a branch between
-                // the two paths costs lavapipe both (measured 13 % slower than always reading prim_refs).
-                let tri_run = HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS;
-                let n = min(count, BVH_MAX_LEAF_PRIMS);
-                for (var k = 0u; k < n; k++) {
-                    var prim: u32;
-                    var h: vec4<f32>;
-                    if tri_run {
-                        prim = first + k; // PRIM_TRIANGLE << 30 | index
-                        if prim == skip { continue; }
-                        h = intersect_triangle(r, tri_verts[3u * prim].xyz, tri_verts[3u * prim + 1u].xyz, tri_verts[3u * prim + 2u].xyz, hit.t);
-                    } else {
-                        prim = prim_refs[first + k];
-                        if prim == skip { continue; }
-                        h = intersect_prim(r, prim, hit.t);
-                    }
-                    // A cut-out point is no hit (HAS_ALPHA is false, and this test gone, in scenes without masks).
-                    if h.w != 0.0 && !(HAS_ALPHA && alpha_cut_out(prim, h.y, h.z)) {
-                        hit = Hit(h.x, prim, h.y, h.z);
-                        if any_hit {
-                            return hit;
-                        }
-                    }
+    for (var round = 0u; round < max_steps && (cur != INVALID || leaf != INVALID || sp > 0u); round++) {
+        for (var step = 0u; step < 2u * max_steps && (bvh_is_interior(cur) || (cur == INVALID && sp > 0u)); step++) {
+            var next = INVALID;
+            if cur != INVALID {
+                let node = bvh_nodes[cur];
+                let l_valid = node.l_count > 0u || node.l_first != INVALID;
+                let r_valid = node.r_count > 0u || node.r_first != INVALID;
+                let tl = select(F32_MAX, ray_box_entry(r, node.lmin, node.lmax, hit.t), l_valid);
+                let tr = select(F32_MAX, ray_box_entry(r, node.rmin, node.rmax, hit.t), r_valid);
+                let lref = bvh_child_ref(node.l_first, node.l_count);
+                let rref = bvh_child_ref(node.r_first, node.r_count);
+                let right_first = tr < tl;
+                let near_t = select(tl, tr, right_first);
+                let far_t = select(tr, tl, right_first);
+                if far_t != F32_MAX && sp < BVH_STACK_SIZE {
+                    bvh_stack_node[base + sp] = select(rref, lref, right_first);
+                    bvh_stack_t[base + sp] = far_t;
+                    sp += 1u;
                 }
-            } else if next == INVALID {
-                next = first;
-            } else if sp < BVH_STACK_SIZE {
-                bvh_stack_node[base + sp] = first;
-                bvh_stack_t[base + sp] = ct;
-                sp += 1u;
+                next = select(INVALID, select(lref, rref, right_first), near_t != F32_MAX);
+                if bvh_is_leaf(next) && leaf == INVALID {
+                    leaf = next;
+                    next = INVALID;
+                }
+            }
+            if next == INVALID {
+                next = bvh_pop(base, &sp, hit.t);
+                if bvh_is_leaf(next) && leaf == INVALID {
+                    leaf = next;
+                    next = INVALID;
+                }
+            }
+            cur = next;
+            if bvh_all_lanes(leaf != INVALID) {
+                break;
             }
         }
-        // Nothing to descend into: pop, dropping subtrees entered beyond the closest hit.
-        for (var k = 0u; k < BVH_STACK_SIZE && next == INVALID && sp > 0u; k++) {
-            sp -= 1u;
-            if bvh_stack_t[base + sp] <= hit.t {
-                next = bvh_stack_node[base + sp];
+        // The postponed leaf's primitives, then the leaf `cur` holds if it is one (and so on).
+        for (var k = 0u; k < 8u * max_steps && leaf != INVALID; k++) {
+            let j = leaf & BVH_LEAF_FIRST_MASK;
+            var prim: u32;
+            var h = vec4<f32>(0.0);
+            if tri_run {
+                prim = j; // PRIM_TRIANGLE << 30 | index
+                if prim != skip {
+                    h = intersect_triangle(r, tri_verts[3u * prim].xyz, tri_verts[3u * prim + 1u].xyz, tri_verts[3u * prim + 2u].xyz, hit.t);
+                }
+            } else {
+                prim = prim_refs[j];
+                if prim != skip {
+                    h = intersect_prim(r, prim, hit.t);
+                }
+            }
+            // A cut-out point is no hit (HAS_ALPHA is false, and this test gone, in scenes without masks).
+            if h.w != 0.0 && !(HAS_ALPHA && alpha_cut_out(prim, h.y, h.z)) {
+                hit = Hit(h.x, prim, h.y, h.z);
+                if any_hit {
+                    return hit;
+                }
+            }
+            if leaf >= BVH_LEAF + BVH_LEAF_COUNT_ONE {
+                leaf += 1u - BVH_LEAF_COUNT_ONE;
+            } else if bvh_is_leaf(cur) {
+                leaf = cur;
+                cur = INVALID;
+            } else {
+                leaf = INVALID;
             }
         }
-        if next == INVALID {
-            break;
-        }
-        node_index = next;
     }
     return hit;
 }

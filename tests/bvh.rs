@@ -111,9 +111,13 @@ impl Geometry {
 }
 
 fn gpu_trace(ctx: &GpuContext, g: &Geometry, bvh: &Bvh, rays: &[ProbeRay]) -> Vec<ProbeTrace> {
+    gpu_trace_source(ctx, g, bvh, rays, &probe_source())
+}
+
+fn gpu_trace_source(ctx: &GpuContext, g: &Geometry, bvh: &Bvh, rays: &[ProbeRay], source: &str) -> Vec<ProbeTrace> {
     let buffers = GeometryBuffers::new(ctx, bvh, &g.tris, &g.spheres, &g.quads);
     Probe::new(ctx)
-        .map(&probe_source(), "ProbeRay", "ProbeTrace", "probe_trace", rays, Some(&buffers))
+        .map(source, "ProbeRay", "ProbeTrace", "probe_trace", rays, Some(&buffers))
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -773,6 +777,33 @@ fn gpu_traversal_matches_reference_on_damaged_helmet() {
     let s = compare(&g, &rays, &gpu, &refs, EDGE_MARGIN);
     check("DamagedHelmet", &s, 1e-3);
     assert!(s.hits as f64 > 0.6 * s.rays as f64, "rays should mostly hit");
+}
+
+/// Both traversals agree with the reference: the speculative one (subgroupAll vote, where the device has subgroup
+/// operations, as lavapipe does) that every other test runs, and the per-lane vote a device without them gets
+/// (the source with the vote's marker line changed, so `shaders::for_device` leaves it alone).
+#[test]
+fn gpu_traversal_without_subgroups_matches_reference() {
+    let ctx = gpu();
+    let source = probe_source();
+    let with_vote = mislab::render::shaders::for_device(&source, ctx.device.features());
+    let subgroups = ctx.device.features().contains(wgpu::Features::SUBGROUP);
+    assert_eq!(
+        with_vote.contains("return subgroupAll(b);"),
+        subgroups,
+        "the vote must follow the device's subgroup feature"
+    );
+    let fallback = source.replace("return b; // BVH_VOTE", "return b;");
+    assert!(!mislab::render::shaders::for_device(&fallback, ctx.device.features()).contains("return subgroupAll(b);"));
+    for (name, g, seed) in [("soup", soup(5), 6), ("DamagedHelmet", helmet(), 7)] {
+        let b = g.build();
+        let rays = make_rays(&g, 30_000, seed);
+        let gpu = gpu_trace_source(&ctx, &g, &b, &rays, &fallback);
+        let refs = reference_hits(&g, &rays);
+        let s = compare(&g, &rays, &gpu, &refs, EDGE_MARGIN);
+        check(&format!("{name} without subgroups"), &s, 1e-3);
+        assert!(s.hits as f64 > 0.6 * s.rays as f64, "rays should mostly hit");
+    }
 }
 
 #[test]

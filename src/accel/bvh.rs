@@ -46,6 +46,8 @@ pub const BVH_STACK_SIZE: usize = 64;
 
 /// Most primitives in one leaf (the leaf collapse of obvhs stops there).
 pub const MAX_LEAF_PRIMS: u32 = 4;
+// The traversal packs a leaf into one word with 3 bits of count (shaders/bvh.wgsl `bvh_child_ref`).
+const _: () = assert!(MAX_LEAF_PRIMS <= 8);
 
 /// A built, flattened BVH, ready to upload (`nodes` → binding 0, `prim_refs` → binding 1 of
 /// `geometry_bindings.wgsl`).

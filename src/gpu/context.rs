@@ -179,7 +179,11 @@ impl GpuContext {
     /// The features and limits we ask for: everything the adapter offers that we use.
     pub fn wanted(adapter: &wgpu::Adapter) -> (wgpu::Features, wgpu::Limits) {
         let available = adapter.features();
-        let features = available & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES);
+        // SUBGROUP: the traversal's speculative vote (shaders/bvh.wgsl bvh_all_lanes, src/render/shaders.rs for_device).
+        let features = available
+            & (wgpu::Features::TIMESTAMP_QUERY
+                | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
+                | wgpu::Features::SUBGROUP);
         (features, adapter.limits())
     }
 
@@ -286,5 +290,17 @@ pub fn describe(ctx: &GpuContext) -> String {
     s += &format!("  max invocations per workgroup: {}\n", l.max_compute_invocations_per_workgroup);
     s += &format!("  max workgroup storage: {} KiB\n", l.max_compute_workgroup_storage_size >> 10);
     s += &format!("  timestamp queries: {}\n", if ctx.timestamps { "yes" } else { "no" });
+    let subgroups = ctx.device.features().contains(wgpu::Features::SUBGROUP);
+    s += &format!(
+        "  subgroup operations: {}\n",
+        if subgroups {
+            format!(
+                "yes, {}-{} lanes (speculative BVH traversal)",
+                ctx.info.subgroup_min_size, ctx.info.subgroup_max_size
+            )
+        } else {
+            "no (plain while-while BVH traversal)".to_string()
+        }
+    );
     s
 }

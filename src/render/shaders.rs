@@ -78,6 +78,22 @@ pub fn validate(source: &str) -> Result<naga::Module, String> {
     Ok(module)
 }
 
+/// The line of `bvh_all_lanes` (shaders/bvh.wgsl) that a device with subgroup operations replaces.
+const BVH_VOTE_FALLBACK: &str = "return b; // BVH_VOTE";
+
+/// A composed module as `device` compiles it: with subgroup operations (wgpu's `Features::SUBGROUP`, which
+/// `GpuContext` requests where offered) the traversal's vote becomes `subgroupAll`; without them the module is unchanged and each lane votes alone (a plain while-while loop).
+/// The one place a device changes shader text, so every pipeline (render, viewer, probes) gets the same code.
+pub fn for_device(source: &str, features: wgpu::Features) -> std::borrow::Cow<'_, str> {
+    let vote_off = std::env::var("MISLAB_BVH_VOTE").is_ok_and(|v| v == "0");
+    if features.contains(wgpu::Features::SUBGROUP) && source.contains(BVH_VOTE_FALLBACK) && !vote_off {
+        // (naga 30 takes subgroup builtins without WGSL's `enable subgroups;`, which it rejects as unimplemented.)
+        source.replace(BVH_VOTE_FALLBACK, "return subgroupAll(b);").into()
+    } else {
+        source.into()
+    }
+}
+
 /// Builds a compute pipeline from a composed module (validated by naga first so errors are readable).
 pub fn compute_pipeline(
     device: &wgpu::Device,
@@ -87,10 +103,11 @@ pub fn compute_pipeline(
     constants: &[(&str, f64)],
     layout: Option<&wgpu::PipelineLayout>,
 ) -> Result<wgpu::ComputePipeline, String> {
-    validate(source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
+    let source = for_device(source, device.features());
+    validate(&source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
+        source: wgpu::ShaderSource::Wgsl(source),
     });
     Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),

@@ -143,7 +143,7 @@ impl<'a> Probe<'a> {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(job.entry),
-            source: wgpu::ShaderSource::Wgsl(job.source.into()),
+            source: wgpu::ShaderSource::Wgsl(crate::render::shaders::for_device(job.source, device.features())),
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(job.entry),
