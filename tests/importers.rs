@@ -130,3 +130,99 @@ fn mitsuba_rough_conductors_keep_beckmann_and_tint() {
     let pbrt = conductors("veach-mis/pbrt-v4/scene-v4.pbrt");
     assert!(!pbrt.is_empty() && pbrt.iter().all(|(t, b)| !*b && *t == glam::Vec3::ONE), "{pbrt:?}");
 }
+
+/// pbrt-v4's `EqualAreaSquareToSphere` (Clarberg's octahedral mapping), written out again here in f64 so the
+/// importer is checked against the formula, not against itself.
+fn pbrt_equal_area_square_to_sphere(px: f64, py: f64) -> [f64; 3] {
+    let (u, v) = (2.0 * px - 1.0, 2.0 * py - 1.0);
+    let (up, vp) = (u.abs(), v.abs());
+    let signed_distance = 1.0 - (up + vp);
+    let r = 1.0 - signed_distance.abs();
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * std::f64::consts::FRAC_PI_4;
+    let z = (1.0 - r * r).copysign(signed_distance);
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    [phi.cos().copysign(u) * s, phi.sin().copysign(v) * s, z]
+}
+
+/// The dining room's infinite light as its pbrt-v4 file writes it (a 7° rotation about z, then the basis change
+/// that puts the map's +z up), with a 64×64 equal-area map dark but for one texel. pbrt-v4 shows that texel in
+/// world direction `Rotate · ConcatTransform · EqualAreaSquareToSphere(texel centre)` (the PFM's rows flipped to
+/// top-first, as pbrt's ReadPFM does). The imported map must put it there, and a render looking along that
+/// direction must see it at the image centre (the device's env lookup); without the 7° rotation it lands 11 px off.
+#[test]
+fn pbrt_infinite_light_follows_pbrt_v4_equal_area_mapping() {
+    let dir = std::env::temp_dir().join(format!("mislab-infinite-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (n, bx, by) = (64usize, 40usize, 20usize); // bright texel, x right, y down from the top row
+    let mut pfm = format!("PF\n{n} {n}\n-1.0\n").into_bytes();
+    for row in (0..n).rev() {
+        for x in 0..n {
+            let v: f32 = if (x, row) == (bx, by) { 1000.0 } else { 0.0 };
+            for _ in 0..3 {
+                pfm.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(dir.join("sky.pfm"), pfm).unwrap();
+
+    // The expected direction: pbrt's Rotate(-7°, z) · ConcatTransform (numbers are columns) · d.
+    let d = pbrt_equal_area_square_to_sphere((bx as f64 + 0.5) / n as f64, (by as f64 + 0.5) / n as f64);
+    let cols = [[-1.0, 0.0, 8.74228e-8], [-8.74228e-8, 0.0, -1.0], [0.0, 1.0, 0.0]];
+    let m: Vec<f64> = (0..3).map(|i| (0..3).map(|j| cols[j][i] * d[j]).sum()).collect();
+    let (s, c) = (-7f64).to_radians().sin_cos();
+    let want = [c * m[0] - s * m[1], s * m[0] + c * m[1], m[2]];
+    let light = "AttributeBegin\n    Rotate -7 0 0 1\n    ConcatTransform [ -1 0 8.74228e-8 0 -8.74228e-8 0 -1 0 0 1 0 0 0 0 0 1 ]\n    LightSource \"infinite\" \"string filename\" \"sky.pfm\"\nAttributeEnd\n";
+
+    // 1. The imported map (CPU): the radiance-weighted mean direction of its texels.
+    std::fs::write(dir.join("map.pbrt"), format!("WorldBegin\n{light}")).unwrap();
+    let path = dir.join("map.pbrt");
+    let scene = mislab::scene::load(path.to_str().unwrap(), &Default::default()).expect("load");
+    let mislab::scene::Environment::Map { map, .. } = &scene.environment else { panic!("no environment map") };
+    let mut sum = [0.0f64; 3];
+    for y in 0..map.height {
+        for x in 0..map.width {
+            let (u, v) = ((x as f32 + 0.5) / map.width as f32, (y as f32 + 0.5) / map.height as f32);
+            let w = map.texels[(y * map.width + x) as usize][0] as f64 * (std::f64::consts::PI * v as f64).sin();
+            let dir = mislab::scene::envmap::equirect_direction(u, v);
+            for k in 0..3 {
+                sum[k] += w * dir[k] as f64;
+            }
+        }
+    }
+    let len = sum.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let cos = (0..3).map(|k| sum[k] / len * want[k]).sum::<f64>();
+    let degrees = cos.clamp(-1.0, 1.0).acos().to_degrees();
+    assert!(degrees < 0.5, "the bright texel lands {degrees:.2}° from pbrt-v4's direction {want:?}");
+
+    // 2. The device: a narrow camera (16° over 33 px) looking along `want` sees the spot at its centre.
+    let camera = format!(
+        "LookAt 0 0 0  {} {} {}  0 1 0\nCamera \"perspective\" \"float fov\" [ 16 ]\nFilm \"rgb\" \"integer xresolution\" [ 33 ] \"integer yresolution\" [ 33 ]\n",
+        want[0], want[1], want[2]
+    );
+    std::fs::write(dir.join("view.pbrt"), format!("{camera}WorldBegin\n{light}")).unwrap();
+    let exr = dir.join("view.exr");
+    let o = Command::new(env!("CARGO_BIN_EXE_mislab"))
+        .arg("render")
+        .arg(dir.join("view.pbrt"))
+        .args(["--mode", "direct", "--spp", "16", "-o", exr.to_str().unwrap()])
+        .output()
+        .expect("run mislab");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let img = mislab::exr_image::read(&exr).expect("read the render");
+    assert_eq!((img.width, img.height), (33, 33));
+    let (mut total, mut cx, mut cy) = (0.0f64, 0.0f64, 0.0f64);
+    for (i, p) in img.pixels.iter().enumerate() {
+        let w = p[0] as f64;
+        total += w;
+        cx += w * (i % 33) as f64;
+        cy += w * (i / 33) as f64;
+    }
+    assert!(total > 0.0, "the render saw nothing of the bright texel: {err}");
+    let (cx, cy) = (cx / total, cy / total);
+    assert!(
+        (cx - 16.0).abs() < 1.0 && (cy - 16.0).abs() < 1.0,
+        "the spot's centroid is at ({cx:.2}, {cy:.2}), not (16, 16)"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
