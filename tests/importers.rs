@@ -226,3 +226,84 @@ fn pbrt_infinite_light_follows_pbrt_v4_equal_area_mapping() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// pbrt-v4's `checkerboard` texture (tex1 where ⌊s⌋ + ⌊t⌋ is even, tex2 where odd, (s, t) = (uscale·u + udelta,
+/// vscale·v + vdelta)) on a quad facing the camera, evaluated on the device: Lambert under a constant white sky,
+/// direct mode with BSDF sampling, so each sample is exactly the reflectance at its point. Every pixel whose
+/// footprint lies inside one check (its corners' (s, t), from the camera model on the CPU, share a cell) must be
+/// that check's colour; pixels across an edge lie between the two colours.
+#[test]
+fn pbrt_checkerboard_matches_cpu() {
+    let dir = std::env::temp_dir().join(format!("mislab-checkerboard-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (tex1, tex2) = ([0.8f32, 0.2, 0.1], [0.1f32, 0.3, 0.9]);
+    let (us, vs, ud, vd) = (4.0f64, 3.0f64, 0.25f64, 0.5f64);
+    let n = 48u32;
+    // `Scale -1 1 1` makes the camera frame right-handed like mislab's, so world +x is the image's right.
+    let file = format!(
+        "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 30 ]\n\
+         Film \"rgb\" \"integer xresolution\" [ {n} ] \"integer yresolution\" [ {n} ]\nWorldBegin\n\
+         LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n\
+         Texture \"checks\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [ {} {} {} ] \"rgb tex2\" [ {} {} {} ]\n\
+         \"float uscale\" [ {us} ] \"float vscale\" [ {vs} ] \"float udelta\" [ {ud} ] \"float vdelta\" [ {vd} ]\n\
+         Material \"diffuse\" \"texture reflectance\" \"checks\"\n\
+         Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n\
+         \"integer indices\" [ 0 1 2 0 2 3 ]\n",
+        tex1[0], tex1[1], tex1[2], tex2[0], tex2[1], tex2[2]
+    );
+    std::fs::write(dir.join("checks.pbrt"), file).unwrap();
+    let exr = dir.join("checks.exr");
+    let o = Command::new(env!("CARGO_BIN_EXE_mislab"))
+        .arg("render")
+        .arg(dir.join("checks.pbrt"))
+        .args(["--mode", "direct", "--strategy", "bsdf", "--spp", "16", "-o", exr.to_str().unwrap()])
+        .output()
+        .expect("run mislab");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(!err.contains("Texture class"), "the checkerboard was not imported: {err}");
+    let img = mislab::exr_image::read(&exr).expect("read the render");
+    assert_eq!((img.width, img.height), (n, n));
+
+    // The camera ray through film point (fx, fy) ∈ [0, n]² meets z = 0 at 5·(sx, sy); pbrt's uv there.
+    let tan = 15f64.to_radians().tan();
+    let st = |fx: f64, fy: f64| {
+        let (x, y) = (5.0 * (2.0 * fx / n as f64 - 1.0) * tan, 5.0 * (1.0 - 2.0 * fy / n as f64) * tan);
+        let (u, v) = ((x + 1.0) / 2.0, (y + 1.0) / 2.0);
+        (us * u + ud, vs * v + vd, (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v))
+    };
+    let (mut exact, mut seen) = (0usize, [0usize; 2]);
+    for y in 0..n {
+        for x in 0..n {
+            let corners: Vec<(f64, f64, bool)> = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                .iter()
+                .map(|(a, b)| st(x as f64 + a, y as f64 + b))
+                .collect();
+            if !corners.iter().all(|c| c.2) {
+                continue; // (partly) off the quad
+            }
+            let px = img.pixels[(y * n + x) as usize];
+            let cell = |c: &(f64, f64, bool)| (c.0.floor() as i64, c.1.floor() as i64);
+            if corners.iter().all(|c| cell(c) == cell(&corners[0])) {
+                let (i, j) = cell(&corners[0]);
+                let odd = (i + j).rem_euclid(2) == 1;
+                let want = if odd { tex2 } else { tex1 };
+                let (s0, t0) = (corners[0].0 as f32 + 1e-3, corners[0].1 as f32 + 1e-3);
+                let twin = mislab::scene::checkerboard(tex1.into(), tex2.into(), s0, t0).to_array();
+                assert_eq!(twin, want, "the CPU twin disagrees at ({s0}, {t0})");
+                for c in 0..3 {
+                    assert!((px[c] - want[c]).abs() < 1e-5, "pixel ({x}, {y}) = {px:?}, its check is {want:?}");
+                }
+                exact += 1;
+                seen[odd as usize] += 1;
+            } else {
+                for c in 0..3 {
+                    let (lo, hi) = (tex1[c].min(tex2[c]), tex1[c].max(tex2[c]));
+                    assert!(px[c] >= lo - 1e-5 && px[c] <= hi + 1e-5, "edge pixel ({x}, {y}) = {px:?}");
+                }
+            }
+        }
+    }
+    assert!(exact > 300 && seen[0] > 100 && seen[1] > 100, "{exact} pixels inside one check ({seen:?})");
+    let _ = std::fs::remove_dir_all(&dir);
+}

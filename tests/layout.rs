@@ -95,7 +95,7 @@ fn shared_structs_match() {
         [lo, phi, hi, second, axis, cos_o, cos_e, light, two_sided, count]
     );
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
-    check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, _pad0]);
+    check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, tex_kind]);
     check!(m, "Accum", GpuAccum, [mean, count, m2, nonfinite]);
     check!(
         m,
@@ -201,6 +201,8 @@ fn tag_constants_match() {
         ("WRAP_REPEAT", WRAP_REPEAT),
         ("WRAP_CLAMP", WRAP_CLAMP),
         ("WRAP_MIRROR", WRAP_MIRROR),
+        ("TEX_IMAGE", TEX_IMAGE),
+        ("TEX_CHECKERBOARD", TEX_CHECKERBOARD),
         ("INVALID", INVALID),
     ] {
         assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");

@@ -452,12 +452,16 @@ impl Parser {
                         t.scale *= s;
                         MatParam::Texture(t)
                     }
+                    MatParam::Checkerboard { tex1, tex2, uv } => {
+                        MatParam::Checkerboard { tex1: tex1 * s, tex2: tex2 * s, uv }
+                    }
                     MatParam::Rgb(c) => MatParam::Rgb(c * s),
                     MatParam::Float(f) => MatParam::Rgb(f * s),
                     other => other,
                 }
             }
             "constant" => self.texture_or_value(p, "value", Vec3::ONE)?,
+            "checkerboard" => self.checkerboard(name, p)?,
             _ => {
                 self.b.ignore(format!("Texture class \"{class}\" (grey 0.5 used)"));
                 MatParam::Rgb(Vec3::splat(0.5))
@@ -468,6 +472,34 @@ impl Parser {
         }
         self.textures.insert(name.to_string(), value);
         Ok(())
+    }
+
+    /// pbrt-v4's 2D `checkerboard` (tex1 = 1, tex2 = 0 by default) under its `uv` mapping
+    /// (s, t) = (uscale·u + udelta, vscale·v + vdelta), evaluated on the device per sample (no filtering).
+    fn checkerboard(&mut self, name: &str, p: &Params) -> Result<MatParam, SceneError> {
+        let mut value = |key: &str, default: f32| -> Result<Vec3, SceneError> {
+            Ok(match self.texture_or_value(p, key, Vec3::splat(default))? {
+                MatParam::Rgb(c) => c,
+                MatParam::Float(f) => Vec3::splat(f),
+                _ => {
+                    self.b.ignore(format!("Texture \"{name}\" \"{key}\" as a texture ({default} used)"));
+                    Vec3::splat(default)
+                }
+            })
+        };
+        let (tex1, tex2) = (value("tex1", 1.0)?, value("tex2", 0.0)?);
+        if p.int("dimension", 2)? != 2 {
+            self.b.ignore(format!("Texture \"{name}\": a 3D checkerboard (grey 0.5 used)"));
+            return Ok(MatParam::Rgb(Vec3::splat(0.5)));
+        }
+        if let Some(m) = p.string("mapping")?.filter(|m| m != "uv") {
+            self.b.ignore(format!("Texture \"{name}\" \"mapping\" \"{m}\" (the uv mapping used)"));
+        }
+        let (us, vs) = (p.float("uscale", 1.0)?, p.float("vscale", 1.0)?);
+        let (ud, vd) = (p.float("udelta", 0.0)?, p.float("vdelta", 0.0)?);
+        // In terms of mislab's flipped v' = 1 − v (add_mesh): t = vs·v + vd = −vs·v' + vs + vd.
+        let uv = [[us, 0.0, ud], [0.0, -vs, vs + vd]];
+        Ok(MatParam::Checkerboard { tex1, tex2, uv })
     }
 
     fn texture_or_value(&mut self, p: &Params, name: &str, default: Vec3) -> Result<MatParam, SceneError> {
