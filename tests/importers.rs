@@ -307,3 +307,29 @@ fn pbrt_checkerboard_matches_cpu() {
     assert!(exact > 300 && seen[0] > 100 && seen[1] > 100, "{exact} pixels inside one check ({seen:?})");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// pbrt's camera space is left-handed (x = up × forward is the image's right): `LookAt 0 0 5  0 0 0  0 1 0` shows
+/// world +x on the LEFT, and `Scale -1 1 1` before it (the usual fix, and what the Bitterli files' `Transform`s
+/// contain) puts it on the right. mislab's camera is right-handed, so the importer mirrors the world under a
+/// proper-rotation camera; a sphere at pbrt's x = +1 must land on the side pbrt shows it.
+#[test]
+fn pbrt_lookat_camera_keeps_pbrt_left_and_right() {
+    let dir = std::env::temp_dir().join(format!("mislab-handedness-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (prefix, left) in [("", true), ("Scale -1 1 1\n", false)] {
+        let text = format!(
+            "{prefix}LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 40 ]\nWorldBegin\n\
+             LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n\
+             AttributeBegin\n  Translate 1 0.5 0\n  Shape \"sphere\" \"float radius\" [ 0.3 ]\nAttributeEnd\n"
+        );
+        let path = dir.join("side.pbrt");
+        std::fs::write(&path, text).unwrap();
+        let s = mislab::scene::load(path.to_str().unwrap(), &Default::default()).expect("load");
+        let (right, up, forward) = s.camera.frame();
+        let to = s.spheres[0].center - s.camera.position;
+        let (x, y) = (to.dot(right) / to.dot(forward), to.dot(up) / to.dot(forward));
+        assert!((x.abs() - 0.2).abs() < 1e-5 && (y - 0.1).abs() < 1e-5, "{prefix:?}: the sphere at ({x}, {y})");
+        assert_eq!(x < 0.0, left, "{prefix:?}: pbrt shows the sphere on the {}", if left { "left" } else { "right" });
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -16,9 +16,13 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::sync::Arc;
 
-/// pbrt's world → mislab's. The identity: with pbrt's camera frame taken as (x right, y up, z forward) the
-/// Bitterli scenes render unmirrored against their references (checked on living-room's TungstenRender.png).
-const MIRROR: DMat4 = DMat4::IDENTITY;
+/// pbrt's world → mislab's when pbrt's camera frame is a proper rotation (a `LookAt`, say). pbrt's camera space
+/// is left-handed (x right, y up, z forward: x = up × forward), mislab's right-handed (right = forward × up), so
+/// such a camera would see the world mirrored; mirroring the whole world in x (geometry, lights, camera) gives
+/// pbrt's picture. A camera transform that already swaps handedness (the Bitterli files' `Transform`s, or the
+/// usual `Scale -1 1 1`) needs none: those scenes render unmirrored against their references.
+const MIRROR_X: DMat4 =
+    DMat4::from_cols_array(&[-1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
 
 /// Nesting depth of Include / Import beyond which a file is refused.
 const MAX_INCLUDE_DEPTH: usize = 32;
@@ -73,6 +77,8 @@ pub struct Parser {
     camera: Option<(DMat4, f64)>,
     film: [u32; 2],
     env_lights: usize,
+    /// pbrt's world → mislab's: the identity, or MIRROR_X under a camera that keeps pbrt's left-handed frame.
+    mirror: DMat4,
 }
 
 impl Parser {
@@ -98,6 +104,7 @@ impl Parser {
             camera: None,
             film: [1280, 720],
             env_lights: 0,
+            mirror: DMat4::IDENTITY,
         }
     }
 
@@ -116,7 +123,7 @@ impl Parser {
         let [w, h] = self.film;
         let mut scene_camera = Camera::default();
         if let Some((camera_from_world, fov)) = self.camera {
-            let wfc = MIRROR * camera_from_world.inverse();
+            let wfc = self.mirror * camera_from_world.inverse();
             let position = wfc.transform_point3(DVec3::ZERO).as_vec3();
             let forward = wfc.transform_vector3(DVec3::Z).normalize().as_vec3();
             let up = wfc.transform_vector3(DVec3::Y).normalize().as_vec3();
@@ -325,6 +332,8 @@ impl Parser {
                     return Err(p.error(format!("Camera fov {fov} is outside (0, 180) degrees")));
                 }
                 self.camera = Some((self.gs.ctm, fov));
+                let proper = glam::DMat3::from_mat4(self.gs.ctm).determinant() > 0.0;
+                self.mirror = if proper { MIRROR_X } else { DMat4::IDENTITY };
             }
             "Film" => {
                 let (w, h) = (p.int("xresolution", 1280)?, p.int("yresolution", 720)?);
@@ -544,7 +553,7 @@ impl Parser {
     }
 
     fn light(&mut self, kind: &str, p: &Params) -> Result<(), SceneError> {
-        let to_world = MIRROR * self.gs.ctm;
+        let to_world = self.mirror * self.gs.ctm;
         let scale = p.float("scale", 1.0)?;
         if p.has("power") || p.has("illuminance") {
             self.b.ignore(format!("LightSource \"{kind}\" \"power\"/\"illuminance\" (scale and L/I are used)"));
@@ -648,7 +657,7 @@ impl Parser {
             }
             _ => {}
         }
-        let to_world = (MIRROR * s.ctm).as_mat4();
+        let to_world = (self.mirror * s.ctm).as_mat4();
         let flip = s.reverse ^ (Mat3::from_mat4(to_world).determinant() < 0.0);
         let mesh: Option<ObjectMesh> = match s.kind.as_str() {
             "trianglemesh" => Some(shapes::inline_mesh(p, "trianglemesh", false)?),
