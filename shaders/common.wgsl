@@ -63,6 +63,8 @@ const SAMPLER_BLUE_NOISE: u32 = 5u;
 const WRAP_REPEAT: u32 = 0u;
 const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
+const TEX_IMAGE: u32 = 0u;
+const TEX_CHECKERBOARD: u32 = 1u;
 
 /// An analytic sphere. Emission, if any, comes from its material; `light` indexes the light table.
 struct Sphere {
@@ -187,7 +189,8 @@ struct TextureInfo {
     wrap_t: u32,
     srgb: u32,
     nearest: u32,
-    _pad0: u32,
+    /// TEX_IMAGE, or TEX_CHECKERBOARD (tex1.rgb, tex2.rgb as f32 bits at `offset`).
+    tex_kind: u32,
 }
 
 /// Per-pixel accumulation: running mean and sum of squared deviations (Welford/Chan), sample count,
@@ -280,6 +283,8 @@ override HAS_DELTA_LIGHTS: bool = true;
 /// 0: no environment, 1: constant, 2: equirectangular map, 3: either (generic).
 override ENV_KIND: u32 = 3u;
 override HAS_TEXTURES: bool = true;
+/// Any pbrt checkerboard texture (TEX_CHECKERBOARD).
+override HAS_CHECKERBOARD: bool = true;
 /// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
 override HAS_SPECULAR: bool = true;
 /// Any MaterialKind::Conductor (bsdf_conductor.wgsl).

@@ -91,11 +91,23 @@ fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
     return c;
 }
 
-/// Bilinear (or nearest) lookup with the texture's wrap modes, after the 2×3 uv transform.
+/// pbrt-v4's 2D checkerboard at (s, t), unfiltered: tex1 where ⌊s⌋ + ⌊t⌋ is even, tex2 where odd (the CPU twin
+/// is scene::checkerboard). The colours are six f32 words at info.offset. Point sampling: the pixel's jittered
+/// samples average the checks over its footprint, where pbrt filters them by ray differentials.
+fn checkerboard_lookup(info: TextureInfo, st: vec2<f32>) -> vec4<f32> {
+    // Clamped so the i32 conversion cannot overflow (±2^24 keeps the parity of exactly representable floors).
+    let f = vec2<i32>(floor(clamp(st, vec2<f32>(-16777216.0), vec2<f32>(16777216.0))));
+    let o = info.offset + select(0u, 3u, ((f.x + f.y) & 1) != 0);
+    return vec4<f32>(bitcast<f32>(tex_texels[o]), bitcast<f32>(tex_texels[o + 1u]), bitcast<f32>(tex_texels[o + 2u]), 1.0);
+}
+
+/// Bilinear (or nearest) lookup with the texture's wrap modes, after the 2×3 uv transform; or a procedural
+/// texture at the transformed uv.
 fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) -> vec4<f32> {
     let info = tex_info[tex];
     let uv = vec2<f32>(dot(xf0.xyz, vec3<f32>(uv_in, 1.0)), dot(xf1.xyz, vec3<f32>(uv_in, 1.0)));
     if (is_nonfinite(uv.x) || is_nonfinite(uv.y)) { return vec4<f32>(0.0); }
+    if (HAS_CHECKERBOARD && info.tex_kind == TEX_CHECKERBOARD) { return checkerboard_lookup(info, uv); }
     let st = uv * vec2<f32>(f32(info.width), f32(info.height)) - 0.5;
     // Keep coordinates in i32 range before the wrap (huge uvs would overflow).
     let stc = clamp(st, vec2<f32>(-1e8), vec2<f32>(1e8));

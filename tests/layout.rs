@@ -91,7 +91,7 @@ fn shared_structs_match() {
     check!(m, "LightChild", mislab::accel::light_tree::GpuLightChild, [lo, phi, hi, cos_o, axis, cos_e]);
     check!(m, "LightNode", mislab::accel::light_tree::GpuLightNode, [c0, c1, next0, next1, two_sided, count]);
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
-    check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, _pad0]);
+    check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, tex_kind]);
     check!(m, "Accum", GpuAccum, [mean, count, m2, nonfinite]);
     check!(
         m,
@@ -197,6 +197,8 @@ fn tag_constants_match() {
         ("WRAP_REPEAT", WRAP_REPEAT),
         ("WRAP_CLAMP", WRAP_CLAMP),
         ("WRAP_MIRROR", WRAP_MIRROR),
+        ("TEX_IMAGE", TEX_IMAGE),
+        ("TEX_CHECKERBOARD", TEX_CHECKERBOARD),
         ("INVALID", INVALID),
         ("LIGHT_LEAF_BIT", mislab::accel::light_tree::LEAF_BIT),
         // The light tree's empty child is the shader's INVALID.

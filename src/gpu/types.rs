@@ -33,6 +33,11 @@ pub const WRAP_REPEAT: u32 = 0;
 pub const WRAP_CLAMP: u32 = 1;
 pub const WRAP_MIRROR: u32 = 2;
 
+/// Texture kinds (`TextureInfo::tex_kind`): texels, or pbrt's checkerboard (two linear RGB colours as six f32 words
+/// at `offset`, no texels).
+pub const TEX_IMAGE: u32 = 0;
+pub const TEX_CHECKERBOARD: u32 = 1;
+
 /// An analytic sphere (WGSL `Sphere`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -152,7 +157,7 @@ pub struct GpuTextureInfo {
     pub wrap_t: u32,
     pub srgb: u32,
     pub nearest: u32,
-    pub _pad0: u32,
+    pub tex_kind: u32,
 }
 
 /// Per-pixel accumulator (WGSL `Accum`).

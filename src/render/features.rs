@@ -39,6 +39,8 @@ pub struct Features {
     pub env: EnvKind,
     /// Any texture.
     pub textures: bool,
+    /// Any pbrt checkerboard texture (`TEX_CHECKERBOARD`).
+    pub checkerboard: bool,
     /// Any material with a GGX lobe.
     pub specular: bool,
     /// Any material with a diffuse lobe.
@@ -77,6 +79,7 @@ impl Features {
             delta_lights: true,
             env: EnvKind::Any,
             textures: true,
+            checkerboard: true,
             specular: true,
             diffuse: true,
             conductor: true,
@@ -111,6 +114,7 @@ impl Features {
             delta_lights: kinds(LIGHT_POINT) || kinds(LIGHT_SPOT) || kinds(LIGHT_DIRECTIONAL),
             env,
             textures: !data.tex_info.is_empty(),
+            checkerboard: data.tex_info.iter().any(|t| t.tex_kind == TEX_CHECKERBOARD),
             specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
@@ -143,6 +147,7 @@ impl Features {
             ("HAS_DELTA_LIGHTS", b(self.delta_lights)),
             ("ENV_KIND", self.env as u32 as f64),
             ("HAS_TEXTURES", b(self.textures)),
+            ("HAS_CHECKERBOARD", b(self.checkerboard)),
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("HAS_CONDUCTOR", b(self.conductor)),
@@ -171,6 +176,7 @@ impl Features {
         on("quad lights", self.quad_lights);
         on("point/spot/directional lights", self.delta_lights);
         on("textures", self.textures);
+        on("checkerboard textures", self.checkerboard);
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);

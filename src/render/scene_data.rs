@@ -288,6 +288,10 @@ fn wrap_tag(w: Wrap) -> u32 {
 
 fn build_textures(scene: &Scene, d: &mut SceneData) {
     for t in &scene.textures {
+        let tex_kind = match t.kind {
+            crate::scene::TextureKind::Image => TEX_IMAGE,
+            crate::scene::TextureKind::Checkerboard { .. } => TEX_CHECKERBOARD,
+        };
         d.tex_info.push(GpuTextureInfo {
             offset: d.tex_texels.len() as u32,
             width: t.width,
@@ -296,9 +300,15 @@ fn build_textures(scene: &Scene, d: &mut SceneData) {
             wrap_t: wrap_tag(t.wrap_t),
             srgb: t.srgb as u32,
             nearest: t.nearest as u32,
-            _pad0: 0,
+            tex_kind,
         });
-        d.tex_texels.extend(t.texels.iter().map(|c| u32::from_le_bytes(*c)));
+        match t.kind {
+            crate::scene::TextureKind::Image => d.tex_texels.extend(t.texels.iter().map(|c| u32::from_le_bytes(*c))),
+            // The two colours as f32 bits: full precision, and values above 1 (a `scale`d checkerboard) survive.
+            crate::scene::TextureKind::Checkerboard { tex1, tex2 } => {
+                d.tex_texels.extend(tex1.to_array().iter().chain(&tex2.to_array()).map(|v| v.to_bits()))
+            }
+        }
     }
 }
 

@@ -113,6 +113,7 @@ impl Builder {
             wrap_s: super::Wrap::Repeat,
             wrap_t: super::Wrap::Repeat,
             nearest: false,
+            kind: super::TextureKind::Image,
         });
         let t = self.scene.textures.len() as u32 - 1;
         self.masks.insert(file.to_path_buf(), t);

@@ -32,6 +32,16 @@ pub enum MatParam {
     Rgb(Vec3),
     /// An image texture.
     Texture(TexDesc),
+    /// pbrt's 2D `checkerboard` of two colours under a UV map (rows as [`TextureRef::transform`], in mislab's
+    /// v-down convention).
+    Checkerboard {
+        /// The even checks.
+        tex1: Vec3,
+        /// The odd checks.
+        tex2: Vec3,
+        /// The UV map.
+        uv: [[f32; 3]; 2],
+    },
     /// A named spectrum (pbrt `"spectrum eta" "metal-Ag-eta"`).
     Spectrum(String),
     /// A string (distribution names and the like).
@@ -229,7 +239,7 @@ pub fn map(
             if tr != re {
                 warn("a dielectric with one tint (specular_transmittance) on both lobes");
             }
-            if desc.params.values().any(|p| matches!(p, MatParam::Texture(_))) {
+            if desc.params.values().any(|p| matches!(p, MatParam::Texture(_) | MatParam::Checkerboard { .. })) {
                 warn("an untextured dielectric");
             }
             let (au, av) = if thin { (0.0, 0.0) } else { (au, av) };
@@ -375,6 +385,10 @@ fn color(
                 let index = cache.load(&t.file, t.srgb, scene)?;
                 let r = TextureRef { texture: index, transform: t.uv, texcoord: 0 };
                 return Ok((t.scale * scale, Some(r)));
+            }
+            Some(MatParam::Checkerboard { tex1, tex2, uv }) => {
+                let index = cache.checkerboard(*tex1, *tex2, scene);
+                return Ok((Vec3::splat(scale), Some(TextureRef { texture: index, transform: *uv, texcoord: 0 })));
             }
             _ => {}
         }

@@ -1,14 +1,15 @@
 //! Image textures for the importers: TGA and PFM (our readers), PNG / JPEG / EXR (the image crate), loaded once
 //! per (file, encoding) into [`Scene::textures`]. Float images are stored sRGB-encoded in 8 bits like the rest.
 
-use super::{read_input::read_bytes, Scene, SceneError, Texture, Wrap};
+use super::{read_input::read_bytes, Scene, SceneError, Texture, TextureKind, Wrap};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// Textures already loaded, by file and sRGB flag.
+/// Textures already loaded, by file and sRGB flag; checkerboards already made, by their colours' bits.
 #[derive(Default)]
 pub struct TextureCache {
     loaded: HashMap<(PathBuf, bool), u32>,
+    checkerboards: HashMap<[u32; 6], u32>,
 }
 
 impl TextureCache {
@@ -29,9 +30,32 @@ impl TextureCache {
             wrap_s: Wrap::Repeat,
             wrap_t: Wrap::Repeat,
             nearest: false,
+            kind: TextureKind::Image,
         });
         self.loaded.insert((file.to_path_buf(), srgb), index);
         Ok(index)
+    }
+
+    /// The index in `scene.textures` of a checkerboard of `tex1` (even checks) and `tex2` (odd), made once.
+    pub fn checkerboard(&mut self, tex1: glam::Vec3, tex2: glam::Vec3, scene: &mut Scene) -> u32 {
+        let mut key = [0u32; 6];
+        for (k, v) in key.iter_mut().zip(tex1.to_array().iter().chain(&tex2.to_array())) {
+            *k = v.to_bits();
+        }
+        *self.checkerboards.entry(key).or_insert_with(|| {
+            scene.textures.push(Texture {
+                name: format!("checkerboard {tex1} / {tex2}"),
+                width: 0,
+                height: 0,
+                texels: vec![],
+                srgb: false,
+                wrap_s: Wrap::Repeat,
+                wrap_t: Wrap::Repeat,
+                nearest: false,
+                kind: TextureKind::Checkerboard { tex1, tex2 },
+            });
+            scene.textures.len() as u32 - 1
+        })
     }
 }
 

@@ -333,7 +333,34 @@ pub enum Wrap {
     Mirror,
 }
 
-/// An RGBA8 texture as stored in the file (sRGB-encoded when `srgb`).
+/// What a texture entry evaluates: its texels, or a procedural pattern (which has none).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum TextureKind {
+    /// The RGBA8 texels, bilinear or nearest.
+    #[default]
+    Image,
+    /// pbrt-v4's 2D `checkerboard`: `tex1` where ⌊s⌋ + ⌊t⌋ is even, `tex2` where it is odd, (s, t) being the
+    /// material's uv transform of the surface uv; point-sampled (linear RGB, no texels, width = height = 0).
+    Checkerboard {
+        /// The even checks.
+        tex1: Vec3,
+        /// The odd checks.
+        tex2: Vec3,
+    },
+}
+
+/// The colour of pbrt-v4's 2D checkerboard at texture coordinates (s, t), unfiltered: tex1 where ⌊s⌋ + ⌊t⌋ is
+/// even (pbrt's `Checkerboard` weight 0.5 − bf(s)·bf(t)/2 = 0), tex2 where it is odd. The device's
+/// `checkerboard_lookup` (shaders/surface.wgsl) computes the same.
+pub fn checkerboard(tex1: Vec3, tex2: Vec3, s: f32, t: f32) -> Vec3 {
+    if (s.floor() as i64 + t.floor() as i64).rem_euclid(2) == 0 {
+        tex1
+    } else {
+        tex2
+    }
+}
+
+/// An RGBA8 texture as stored in the file (sRGB-encoded when `srgb`), or a procedural one (`kind`).
 #[derive(Clone, Debug)]
 pub struct Texture {
     /// Name or URI, for messages.
@@ -352,6 +379,8 @@ pub struct Texture {
     pub wrap_t: Wrap,
     /// Nearest-neighbour magnification instead of bilinear.
     pub nearest: bool,
+    /// Image or procedural.
+    pub kind: TextureKind,
 }
 
 /// A delta light (KHR_lights_punctual). Intensity is in the scene's radiance units: W/sr for point and

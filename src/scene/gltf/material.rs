@@ -96,7 +96,8 @@ impl Loader<'_> {
                 let name = texture.name.clone().unwrap_or_else(|| image_name(root, image));
                 let (width, height, texels) = (decoded.width, decoded.height, decoded.texels.clone());
                 let id = self.scene.textures.len() as u32;
-                self.scene.textures.push(Texture { name, width, height, texels, srgb, wrap_s, wrap_t, nearest });
+                let kind = crate::scene::TextureKind::Image;
+                self.scene.textures.push(Texture { name, width, height, texels, srgb, wrap_s, wrap_t, nearest, kind });
                 self.textures.insert(key, id);
                 id
             }

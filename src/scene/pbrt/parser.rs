@@ -16,9 +16,13 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::sync::Arc;
 
-/// pbrt's world → mislab's. The identity: with pbrt's camera frame taken as (x right, y up, z forward) the
-/// Bitterli scenes render unmirrored against their references (checked on living-room's TungstenRender.png).
-const MIRROR: DMat4 = DMat4::IDENTITY;
+/// pbrt's world → mislab's when pbrt's camera frame is a proper rotation (a `LookAt`, say). pbrt's camera space
+/// is left-handed (x right, y up, z forward: x = up × forward), mislab's right-handed (right = forward × up), so
+/// such a camera would see the world mirrored; mirroring the whole world in x (geometry, lights, camera) gives
+/// pbrt's picture. A camera transform that already swaps handedness (the Bitterli files' `Transform`s, or the
+/// usual `Scale -1 1 1`) needs none: those scenes render unmirrored against their references.
+const MIRROR_X: DMat4 =
+    DMat4::from_cols_array(&[-1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
 
 /// Nesting depth of Include / Import beyond which a file is refused.
 const MAX_INCLUDE_DEPTH: usize = 32;
@@ -73,6 +77,8 @@ pub struct Parser {
     camera: Option<(DMat4, f64)>,
     film: [u32; 2],
     env_lights: usize,
+    /// pbrt's world → mislab's: the identity, or MIRROR_X under a camera that keeps pbrt's left-handed frame.
+    mirror: DMat4,
 }
 
 impl Parser {
@@ -98,6 +104,7 @@ impl Parser {
             camera: None,
             film: [1280, 720],
             env_lights: 0,
+            mirror: DMat4::IDENTITY,
         }
     }
 
@@ -116,7 +123,7 @@ impl Parser {
         let [w, h] = self.film;
         let mut scene_camera = Camera::default();
         if let Some((camera_from_world, fov)) = self.camera {
-            let wfc = MIRROR * camera_from_world.inverse();
+            let wfc = self.mirror * camera_from_world.inverse();
             let position = wfc.transform_point3(DVec3::ZERO).as_vec3();
             let forward = wfc.transform_vector3(DVec3::Z).normalize().as_vec3();
             let up = wfc.transform_vector3(DVec3::Y).normalize().as_vec3();
@@ -325,6 +332,8 @@ impl Parser {
                     return Err(p.error(format!("Camera fov {fov} is outside (0, 180) degrees")));
                 }
                 self.camera = Some((self.gs.ctm, fov));
+                let proper = glam::DMat3::from_mat4(self.gs.ctm).determinant() > 0.0;
+                self.mirror = if proper { MIRROR_X } else { DMat4::IDENTITY };
             }
             "Film" => {
                 let (w, h) = (p.int("xresolution", 1280)?, p.int("yresolution", 720)?);
@@ -452,12 +461,16 @@ impl Parser {
                         t.scale *= s;
                         MatParam::Texture(t)
                     }
+                    MatParam::Checkerboard { tex1, tex2, uv } => {
+                        MatParam::Checkerboard { tex1: tex1 * s, tex2: tex2 * s, uv }
+                    }
                     MatParam::Rgb(c) => MatParam::Rgb(c * s),
                     MatParam::Float(f) => MatParam::Rgb(f * s),
                     other => other,
                 }
             }
             "constant" => self.texture_or_value(p, "value", Vec3::ONE)?,
+            "checkerboard" => self.checkerboard(name, p)?,
             _ => {
                 self.b.ignore(format!("Texture class \"{class}\" (grey 0.5 used)"));
                 MatParam::Rgb(Vec3::splat(0.5))
@@ -468,6 +481,34 @@ impl Parser {
         }
         self.textures.insert(name.to_string(), value);
         Ok(())
+    }
+
+    /// pbrt-v4's 2D `checkerboard` (tex1 = 1, tex2 = 0 by default) under its `uv` mapping
+    /// (s, t) = (uscale·u + udelta, vscale·v + vdelta), evaluated on the device per sample (no filtering).
+    fn checkerboard(&mut self, name: &str, p: &Params) -> Result<MatParam, SceneError> {
+        let mut value = |key: &str, default: f32| -> Result<Vec3, SceneError> {
+            Ok(match self.texture_or_value(p, key, Vec3::splat(default))? {
+                MatParam::Rgb(c) => c,
+                MatParam::Float(f) => Vec3::splat(f),
+                _ => {
+                    self.b.ignore(format!("Texture \"{name}\" \"{key}\" as a texture ({default} used)"));
+                    Vec3::splat(default)
+                }
+            })
+        };
+        let (tex1, tex2) = (value("tex1", 1.0)?, value("tex2", 0.0)?);
+        if p.int("dimension", 2)? != 2 {
+            self.b.ignore(format!("Texture \"{name}\": a 3D checkerboard (grey 0.5 used)"));
+            return Ok(MatParam::Rgb(Vec3::splat(0.5)));
+        }
+        if let Some(m) = p.string("mapping")?.filter(|m| m != "uv") {
+            self.b.ignore(format!("Texture \"{name}\" \"mapping\" \"{m}\" (the uv mapping used)"));
+        }
+        let (us, vs) = (p.float("uscale", 1.0)?, p.float("vscale", 1.0)?);
+        let (ud, vd) = (p.float("udelta", 0.0)?, p.float("vdelta", 0.0)?);
+        // In terms of mislab's flipped v' = 1 − v (add_mesh): t = vs·v + vd = −vs·v' + vs + vd.
+        let uv = [[us, 0.0, ud], [0.0, -vs, vs + vd]];
+        Ok(MatParam::Checkerboard { tex1, tex2, uv })
     }
 
     fn texture_or_value(&mut self, p: &Params, name: &str, default: Vec3) -> Result<MatParam, SceneError> {
@@ -512,7 +553,7 @@ impl Parser {
     }
 
     fn light(&mut self, kind: &str, p: &Params) -> Result<(), SceneError> {
-        let to_world = MIRROR * self.gs.ctm;
+        let to_world = self.mirror * self.gs.ctm;
         let scale = p.float("scale", 1.0)?;
         if p.has("power") || p.has("illuminance") {
             self.b.ignore(format!("LightSource \"{kind}\" \"power\"/\"illuminance\" (scale and L/I are used)"));
@@ -616,7 +657,7 @@ impl Parser {
             }
             _ => {}
         }
-        let to_world = (MIRROR * s.ctm).as_mat4();
+        let to_world = (self.mirror * s.ctm).as_mat4();
         let flip = s.reverse ^ (Mat3::from_mat4(to_world).determinant() < 0.0);
         let mesh: Option<ObjectMesh> = match s.kind.as_str() {
             "trianglemesh" => Some(shapes::inline_mesh(p, "trianglemesh", false)?),
