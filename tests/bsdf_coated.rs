@@ -304,9 +304,12 @@ fn toml_coated_diffuse_syntax() {
     let s = load(FURNACE, "furnace-coated.toml");
     assert!(matches!(s.environment, Environment::Constant(_)));
     let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap_or_else(|| panic!("{n}"));
-    assert_eq!(m("white_aniso").kind, MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.05, alpha_v: 0.3 });
+    assert_eq!(
+        m("white_aniso").kind,
+        MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.05, alpha_v: 0.3, beckmann: false }
+    );
     assert_eq!(m("red").base_color, Vec3::new(0.243, 0.059, 0.0008));
-    assert_eq!(m("red").kind, MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.2, alpha_v: 0.2 });
+    assert_eq!(m("red").kind, MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.2, alpha_v: 0.2, beckmann: false });
     let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bad-coated.toml");
     for (body, says) in [
         ("eta = 0.8\nalpha = 0.1", "one finite number > 1"),
@@ -385,7 +388,12 @@ fn coated_render_has_no_nan() {
     let etas = [1.5f32, 1.1, 2.5];
     for (i, m) in s.materials.iter_mut().enumerate().filter(|(_, m)| !m.is_emissive()) {
         let a = alphas[i % alphas.len()];
-        m.kind = MaterialKind::CoatedDiffuse { eta: etas[i % etas.len()], alpha_u: a, alpha_v: a.max(ALPHA_MIN) * 2.0 };
+        m.kind = MaterialKind::CoatedDiffuse {
+            eta: etas[i % etas.len()],
+            alpha_u: a,
+            alpha_v: a.max(ALPHA_MIN) * 2.0,
+            beckmann: i % 2 == 1,
+        };
     }
     let data = mislab::scene_data::SceneData::build(&s);
     let f = mislab::features::Features::of(&data);
@@ -441,11 +449,14 @@ AttributeEnd
     std::fs::write(&path, pbrt).unwrap();
     let s = scene::load(path.to_str().unwrap(), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap_or_else(|| panic!("{n}: {:?}", s.materials));
-    assert_eq!(m("WhitePlastic").kind, MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.2, alpha_v: 0.1 });
+    assert_eq!(
+        m("WhitePlastic").kind,
+        MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.2, alpha_v: 0.1, beckmann: false }
+    );
     assert_eq!(m("WhitePlastic").base_color, Vec3::ONE);
     // remaproughness (pbrt's default): α = √roughness; pbrt's default reflectance 0.5.
     match m("Remapped").kind {
-        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v } => {
+        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v, beckmann: false } => {
             assert!(eta == 1.33 && (alpha_u - 0.2).abs() < 1e-6 && alpha_u == alpha_v, "{:?}", m("Remapped").kind)
         }
         ref k => panic!("Remapped: {k:?}"),
@@ -484,8 +495,8 @@ AttributeEnd
     assert!(((r / (1.0 - r * fi)) - 0.5 / (1.0 - fi)).abs() < 1e-5, "plastic base {r} (F̄ᵢ {fi})");
     let rough = find(&|k| matches!(k, MaterialKind::CoatedDiffuse { alpha_u, .. } if *alpha_u == 0.3)).expect("rough");
     match rough.kind {
-        MaterialKind::CoatedDiffuse { eta, alpha_v, .. } => {
-            assert!((eta - 1.6 / 1.000277).abs() < 1e-6 && alpha_v == 0.3)
+        MaterialKind::CoatedDiffuse { eta, alpha_v, beckmann, .. } => {
+            assert!((eta - 1.6 / 1.000277).abs() < 1e-6 && alpha_v == 0.3 && !beckmann)
         }
         _ => unreachable!(),
     }
@@ -503,7 +514,7 @@ fn bitterli_coated_materials_import() {
     let n = s.materials.iter().filter(|m| matches!(m.kind, MaterialKind::CoatedDiffuse { .. })).count();
     assert!(n >= 7, "dining room: {n} coated diffuse materials");
     let ceramic = s.materials.iter().find(|m| m.name == "Ceramic").expect("Ceramic");
-    assert_eq!(ceramic.kind, MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.01, alpha_v: 0.01 });
+    assert_eq!(ceramic.kind, MaterialKind::CoatedDiffuse { eta: 1.5, alpha_u: 0.01, alpha_v: 0.01, beckmann: false });
     let painted = s.materials.iter().find(|m| m.name == "PaintedCeramic").expect("PaintedCeramic");
     assert!(painted.base_color_texture.is_some(), "PaintedCeramic keeps its texture");
     assert!(!s.warnings.iter().any(|w| w.contains("coateddiffuse")), "{:?}", s.warnings);

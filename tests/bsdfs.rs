@@ -385,7 +385,14 @@ fn toml_dielectric_syntax() {
     let get = |n: &str| s.materials.iter().find(|m| m.name == n).map(|m| m.kind.clone()).expect(n);
     assert_eq!(
         get("glass"),
-        MaterialKind::Dielectric { eta: 1.5, alpha_u: 0.0, alpha_v: 0.0, tint: glam::Vec3::ONE, thin: false }
+        MaterialKind::Dielectric {
+            eta: 1.5,
+            alpha_u: 0.0,
+            alpha_v: 0.0,
+            tint: glam::Vec3::ONE,
+            thin: false,
+            beckmann: false
+        }
     );
     assert!(matches!(get("thin"), MaterialKind::Dielectric { thin: true, .. }));
     assert!(matches!(get("nearly_smooth"), MaterialKind::Dielectric { alpha_u, .. } if alpha_u == 0.01));
