@@ -300,8 +300,28 @@ fn coated_diffuse(
         if medium {
             warn("its layer medium (thickness/albedo/g) is ignored: the analytic coat has no medium");
         }
-    } else {
-        if !matches!(desc.params.get("nonlinear"), Some(MatParam::Bool(true))) {
+    }
+    // Mitsuba's roughplastic is Beckmann unless it says ggx; pbrt-v4's coat is always GGX; `plastic` is smooth.
+    let beckmann = desc.kind == "roughplastic" && mitsuba_beckmann(desc, &mut warn);
+    let nonlinear = matches!(desc.params.get("nonlinear"), Some(MatParam::Bool(true)));
+    if desc.kind == "roughplastic" {
+        // Mitsuba's diffuse term is r/(1 − F̄ᵢ) (linear) or r/(1 − r·F̄ᵢ) (nonlinear) with ITS internal reflectance,
+        // estimated over the rough interface (smaller than the smooth one this model uses: 0.524 against 0.590
+        // for Beckmann α 0.3): the base is chosen so that this model's R'/(1 − R'·F̄ᵢ) equals that term.
+        let fi = super::coated::coated_internal_reflectance(eta);
+        let fi_m = super::coated::mitsuba_rough_internal_reflectance(eta, au, beckmann);
+        let conv = |r: f32| {
+            let r = r.clamp(0.0, 1.0);
+            let target = if nonlinear { r / (1.0 - r * fi_m) } else { r / (1.0 - fi_m) };
+            super::coated::reflectance_for_diffuse_term(target, fi)
+        };
+        c = Vec3::new(conv(c.x), conv(c.y), conv(c.z));
+        if t.is_some() {
+            warn("Mitsuba's diffuse reflectance of a texture converted at the texture factor");
+        }
+    }
+    if !pbrt {
+        if desc.kind == "plastic" && !nonlinear {
             // Mitsuba's default linear form: its reflectance is the base's share; converted exactly for colours.
             let fi = super::coated::coated_internal_reflectance(eta);
             let lin = |r: f32| super::coated::reflectance_from_linear(r, fi);
@@ -314,8 +334,6 @@ fn coated_diffuse(
             warn("specular_reflectance other than 1 is ignored");
         }
     }
-    // Mitsuba's roughplastic is Beckmann unless it says ggx; pbrt-v4's coat is always GGX; `plastic` is smooth.
-    let beckmann = desc.kind == "roughplastic" && mitsuba_beckmann(desc, &mut warn);
     let m = Material {
         kind: MaterialKind::CoatedDiffuse { eta, alpha_u: au, alpha_v: av, beckmann },
         ..Material::coated_diffuse(&desc.name, c, eta, au)
