@@ -229,7 +229,7 @@ pub fn map(
             }
             let (au, av) = if thin { (0.0, 0.0) } else { (au, av) };
             let kind = MaterialKind::Dielectric { eta, alpha_u: au, alpha_v: av, tint: tr, thin, beckmann };
-            Material { kind, base_color: tr, specular: 0.0, ..Default::default() }
+            Material { name: desc.name.clone(), kind, base_color: tr, specular: 0.0, ..Default::default() }
         }
         "interface" | "null" => {
             warn("invisible: its shapes are left out (an interface between media, which mislab does not have)");
