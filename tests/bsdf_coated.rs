@@ -545,6 +545,18 @@ fn coated_white_furnace() {
     }
 }
 
+/// Light-only sampling cannot reach a lamp seen in a smooth coat's mirror lobe, and says so; a rough coat needs no
+/// warning.
+#[test]
+fn smooth_coat_light_only_warns() {
+    let settings = Settings { strategy: Strategy::Light, ..common::small(8, 8) };
+    let smooth = mislab::scene_data::SceneData::build(&load(SMOOTH_FURNACE, "warn-smooth-coat.toml"));
+    let w = mislab::reachability::unreachable_light_warning(&smooth, &settings).expect("a smooth coat warns");
+    assert!(w.contains("smooth coat") && w.contains("1 delta"), "{w}");
+    let rough = mislab::scene_data::SceneData::build(&load(BECKMANN_FURNACE, "warn-rough-coat.toml"));
+    assert_eq!(mislab::reachability::unreachable_light_warning(&rough, &settings), None);
+}
+
 /// The Cornell box with every surface coated (α from 0, i.e. ALPHA_MIN, to 0.5, η 1.1–2.5), rendered with MIS:
 /// no NaN/Inf sample, and a lit image.
 #[test]
