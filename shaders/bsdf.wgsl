@@ -39,6 +39,12 @@ fn bsdf_is_delta(p: BsdfParams) -> bool {
     return false;
 }
 
+/// Whether the material has a delta lobe beside others (a smooth coat's mirror): light sampling still serves the
+/// rest, but the hemisphere techniques (uniform, cosine) cannot reach the lobe.
+fn bsdf_has_delta_lobe(p: BsdfParams) -> bool {
+    return HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE && coated_is_smooth(p);
+}
+
 /// Whether the material transmits (wi below the surface is allowed: two-sided light sampling, |cos|).
 fn bsdf_transmits(p: BsdfParams) -> bool {
     return (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC)

@@ -11,8 +11,11 @@
 // F̄ᵢ: the coat's diffuse (cosine-averaged) reflectance seen from inside, so that R/(1 − R·F̄ᵢ) sums the light
 // bouncing between base and coat. The base's transmission uses the smooth Fresnel term at the macro normal.
 // For R = 1 and a smooth coat the base returns exactly 1 − F(cosθo) (as 1 − F̄ᵢ = (1 − F̄ₑ)/η²).
+// Beckmann coat (p.specular = 1, Mitsuba 3's roughplastic default): D and the separable G = G1(wo)·G1(wi) of
+// Walter et al.'s rational fit (bsdf_conductor.wgsl's beckmann_*, as Mitsuba 3), h sampled from D(h)·cosθh.
 // Sampling: the coat's visible normals with probability ps (its Fresnel weight against the base's albedo), else
-// cosine-weighted. Reached only where the scene has a coated diffuse material (HAS_COATED_DIFFUSE).
+// cosine-weighted. A smooth coat (max α < DELTA_ALPHA) is an exact mirror lobe of weight F(cosθo): a delta sample
+// (BsdfSample.delta, pdf ps) that eval and pdf do not see; they are the base's alone. Reached only where the scene has a coated diffuse material (HAS_COATED_DIFFUSE).
 // Parameters: base_color = R (texture applied), eta.x = η, alpha / alpha_v = GGX α along tangent / bitangent.
 
 /// Unpolarised Fresnel reflectance of a dielectric interface for light arriving from the side of index 1 at
@@ -42,6 +45,10 @@ fn coated_internal_reflectance(eta: f32) -> f32 {
     return 1.0 - (1.0 - fe) / (eta * eta);
 }
 
+fn coated_is_beckmann(p: BsdfParams) -> bool { return p.specular == 1.0; }
+
+fn coated_is_smooth(p: BsdfParams) -> bool { return max(p.alpha, p.alpha_v) < DELTA_ALPHA; }
+
 /// The base's reflectance, capped at 1 (a texture times a factor may exceed it; 1 − R·F̄ᵢ must stay positive).
 fn coated_base(p: BsdfParams) -> vec3<f32> {
     return clamp(p.base_color, vec3<f32>(0.0), vec3<f32>(1.0));
@@ -65,20 +72,36 @@ fn coated_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let h = normalize(wo + wi);
     let au = p.alpha;
     let av = p.alpha_v;
-    let g2 = 1.0 / (1.0 + aniso_ggx_lambda(wo, au, av) + aniso_ggx_lambda(wi, au, av));
-    let coat = coated_fresnel(dot(wo, h), eta) * aniso_ggx_d(h, au, av) * g2 / (4.0 * wo.z * wi.z);
+    var coat = 0.0;
+    if (coated_is_smooth(p)) {
+        // The mirror lobe is a delta: only coated_sample reaches it.
+    } else if (coated_is_beckmann(p)) {
+        let g = beckmann_g1(wo, h, au, av) * beckmann_g1(wi, h, au, av);
+        coat = coated_fresnel(dot(wo, h), eta) * beckmann_d(h, au, av) * g / (4.0 * wo.z * wi.z);
+    } else {
+        let g2 = 1.0 / (1.0 + aniso_ggx_lambda(wo, au, av) + aniso_ggx_lambda(wi, au, av));
+        coat = coated_fresnel(dot(wo, h), eta) * aniso_ggx_d(h, au, av) * g2 / (4.0 * wo.z * wi.z);
+    }
     let r = coated_base(p);
     let fi = coated_internal_reflectance(eta);
     let t = (1.0 - coated_fresnel(wo.z, eta)) * (1.0 - coated_fresnel(wi.z, eta)) / (PI * eta * eta);
     return vec3<f32>(coat) + t * r / (vec3<f32>(1.0) - r * fi);
 }
 
-/// pdf (solid angle) of coated_sample producing wi: ps·G1(wo)·D(h)/(4 wo.z) + (1 − ps)·cosθi/π.
+/// pdf (solid angle) of coated_sample producing wi: ps·G1(wo)·D(h)/(4 wo.z) + (1 − ps)·cosθi/π (Beckmann:
+/// ps·D(h)·cosθh/(4 |wo·h|) for the coat).
 fn coated_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
     let ps = coated_coat_probability(p, wo);
     let h = normalize(wo + wi);
-    let coat = aniso_ggx_g1(wo, p.alpha, p.alpha_v) * aniso_ggx_d(h, p.alpha, p.alpha_v) / (4.0 * wo.z);
+    var coat = 0.0;
+    if (coated_is_smooth(p)) {
+        // A delta lobe has no density.
+    } else if (coated_is_beckmann(p)) {
+        coat = beckmann_d(h, p.alpha, p.alpha_v) * h.z / (4.0 * abs(dot(wo, h)));
+    } else {
+        coat = aniso_ggx_g1(wo, p.alpha, p.alpha_v) * aniso_ggx_d(h, p.alpha, p.alpha_v) / (4.0 * wo.z);
+    }
     return ps * coat + (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
 }
 
@@ -87,9 +110,24 @@ fn coated_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> Bsd
     var s: BsdfSample;
     s.pdf = 0.0;
     s.f = vec3<f32>(0.0);
+    s.delta = false;
     if (wo.z <= 0.0) { return s; }
-    if (u_lobe < coated_coat_probability(p, wo)) {
-        let h = aniso_ggx_sample_visible_normal(wo, p.alpha, p.alpha_v, u);
+    let ps = coated_coat_probability(p, wo);
+    if (u_lobe < ps && coated_is_smooth(p)) {
+        // The smooth coat's mirror: weight f·cosθi/pdf = F(cosθo)/ps.
+        s.wi = vec3<f32>(-wo.x, -wo.y, wo.z);
+        s.pdf = ps;
+        s.delta = true;
+        s.f = vec3<f32>(coated_fresnel(wo.z, p.eta.x) / wo.z);
+        return s;
+    }
+    if (u_lobe < ps) {
+        var h: vec3<f32>;
+        if (coated_is_beckmann(p)) {
+            h = beckmann_sample_normal(p.alpha, p.alpha_v, u);
+        } else {
+            h = aniso_ggx_sample_visible_normal(wo, p.alpha, p.alpha_v, u);
+        }
         s.wi = reflect(-wo, h);
     } else {
         s.wi = square_to_cosine_hemisphere(u);

@@ -11,6 +11,8 @@
 //   Rough: anisotropic GGX (as bsdf_conductor.wgsl) with Walter et al. 2007's BTDF (eq. 21) and the generalized
 //     half vector wm = normalize(η'·wi + wo) (eq. 16); a visible normal of wo is sampled, then reflection with
 //     probability F(wo·wm), else refraction about wm; pdf from the Jacobians of eq. 14 and 17.
+//     Beckmann (p.specular = 1, Mitsuba 3's default): D and the separable G = G1(wo)·G1(wi) of Walter et al.'s
+//     rational fit (bsdf_conductor.wgsl's beckmann_*, as Mitsuba 3 evaluates them); wm drawn from D(wm)·cosθm.
 //   Thin (p.eta.y = 1, Mitsuba's thindielectric): a slab of two parallel smooth interfaces; its internal bounces
 //     sum to R' = R + T²R/(1 − R²), and transmission continues straight through (wi = −wo, no 1/η² scaling).
 // p.base_color is the tint on both lobes. Reached only where the scene has a dielectric (HAS_DIELECTRIC).
@@ -49,6 +51,8 @@ fn refract_dielectric(wo: vec3<f32>, n_in: vec3<f32>, eta_in: f32) -> vec4<f32> 
     return vec4<f32>(normalize(-wo / eta + (c / eta - cos_t) * n), eta);
 }
 
+fn dielectric_is_beckmann(p: BsdfParams) -> bool { return p.specular == 1.0; }
+
 fn dielectric_is_smooth(p: BsdfParams) -> bool {
     return max(p.alpha, p.alpha_v) < DELTA_ALPHA || p.eta.y != 0.0;
 }
@@ -74,8 +78,15 @@ fn dielectric_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let wm = hv.xyz;
     let au = p.alpha;
     let av = p.alpha_v;
-    let d = aniso_ggx_d(wm, au, av);
-    let g = 1.0 / (1.0 + aniso_ggx_lambda(wo, au, av) + aniso_ggx_lambda(wi, au, av));
+    var d: f32;
+    var g: f32;
+    if (dielectric_is_beckmann(p)) {
+        d = beckmann_d(wm, au, av);
+        g = beckmann_g1(wo, wm, au, av) * beckmann_g1(wi, wm, au, av);
+    } else {
+        d = aniso_ggx_d(wm, au, av);
+        g = 1.0 / (1.0 + aniso_ggx_lambda(wo, au, av) + aniso_ggx_lambda(wi, au, av));
+    }
     let f = fresnel_dielectric(dot(wo, wm), p.eta.x);
     if (wo.z * wi.z > 0.0) {
         return p.base_color * (d * g * f / abs(4.0 * wo.z * wi.z));
@@ -95,8 +106,13 @@ fn dielectric_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     let au = p.alpha;
     let av = p.alpha_v;
     let f = fresnel_dielectric(dot(wo, wm), p.eta.x);
-    // Density of the visible normal wm seen from wo: G1(wo)·D(wm)·|wo·wm| / |wo.z|.
-    let d_vis = aniso_ggx_g1(wo, au, av) * aniso_ggx_d(wm, au, av) * abs(dot(wo, wm)) / abs(wo.z);
+    // Density of wm: GGX's visible normal seen from wo, G1(wo)·D(wm)·|wo·wm| / |wo.z|; Beckmann's D(wm)·cosθm.
+    var d_vis: f32;
+    if (dielectric_is_beckmann(p)) {
+        d_vis = beckmann_d(wm, au, av) * wm.z;
+    } else {
+        d_vis = aniso_ggx_g1(wo, au, av) * aniso_ggx_d(wm, au, av) * abs(dot(wo, wm)) / abs(wo.z);
+    }
     if (wo.z * wi.z > 0.0) {
         return d_vis / (4.0 * abs(dot(wo, wm))) * f;
     }
@@ -143,9 +159,16 @@ fn dielectric_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) ->
         s.f = p.base_color * (t / (abs(s.wi.z) * rt.w * rt.w));
         return s;
     }
-    // Visible normals of the side wo is on (the distribution is symmetric under z → −z).
-    let side = select(-1.0, 1.0, wo.z > 0.0);
-    let wm = aniso_ggx_sample_visible_normal(wo * side, p.alpha, p.alpha_v, u);
+    // Visible normals of the side wo is on (the distribution is symmetric under z → −z); Beckmann's wm, drawn
+    // from D·cos alone, may face away from wo: a failed sample.
+    var wm: vec3<f32>;
+    if (dielectric_is_beckmann(p)) {
+        wm = beckmann_sample_normal(p.alpha, p.alpha_v, u);
+        if (dot(wo, wm) * wo.z <= 0.0) { return s; }
+    } else {
+        let side = select(-1.0, 1.0, wo.z > 0.0);
+        wm = aniso_ggx_sample_visible_normal(wo * side, p.alpha, p.alpha_v, u);
+    }
     let f = fresnel_dielectric(dot(wo, wm), eta);
     if (u_lobe < f) {
         s.wi = reflect(-wo, wm);

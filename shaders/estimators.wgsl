@@ -37,7 +37,7 @@ fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32)
 /// The direction technique a strategy uses at c: uniform, cosine, or the BSDF (also for light / mis). Surfaces
 /// that transmit or have delta lobes always use the BSDF: the hemisphere techniques cannot reach those directions.
 fn direction_technique(c: ShadingCtx) -> u32 {
-    if (bsdf_transmits(c.brdf) || bsdf_is_delta(c.brdf)) { return STRATEGY_BSDF; }
+    if (bsdf_transmits(c.brdf) || bsdf_is_delta(c.brdf) || bsdf_has_delta_lobe(c.brdf)) { return STRATEGY_BSDF; }
     if (cfg_strategy() == STRATEGY_UNIFORM || cfg_strategy() == STRATEGY_COSINE) { return cfg_strategy(); }
     return STRATEGY_BSDF;
 }

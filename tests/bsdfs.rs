@@ -222,24 +222,52 @@ material = "rough"
 constant = 1
 "#;
 
+/// Rough Beckmann glass alone (Mitsuba's roughdielectric default distribution).
+const BECKMANN_FURNACE: &str = r#"
+[camera]
+position = [0, 0, 9]
+look_at = [0, 0, 0]
+vfov = 20
+
+[materials.rough]
+type = "dielectric"
+eta = 1.5
+alpha = 0.3
+distribution = "beckmann"
+
+[[sphere]]
+center = [0, 0, 0]
+radius = 0.5
+material = "rough"
+
+[environment]
+constant = 1
+"#;
+
 #[test]
 fn dielectric_white_furnace() {
     let ctx = common::gpu();
     let s = load(GLASS_FURNACE, "furnace-glass.toml");
     let rough_scene = load(ROUGH_FURNACE, "furnace-rough-glass.toml");
+    let beckmann_scene = load(BECKMANN_FURNACE, "furnace-beckmann-glass.toml");
     let (w, h) = (128u32, 32u32);
     let mut rough = vec![];
+    let mut beckmann = vec![];
     for strategy in [Strategy::Bsdf, Strategy::Mis] {
         // No Russian roulette (its weights are exact but noisy) and paths long enough that internal reflections
         // always leave: then every smooth-glass, thin and diffuse-transmission sample is 1 up to rounding.
         let settings = Settings { max_depth: 64, rr_depth: 64, strategy, mode: Mode::Path, ..common::small(w, h) };
         let film = common::render(&ctx, &s, &settings, 32);
         let film_rough = common::render(&ctx, &rough_scene, &settings, 32);
-        let bad: u32 = film.nonfinite.iter().chain(&film_rough.nonfinite).sum();
+        let film_beckmann = common::render(&ctx, &beckmann_scene, &settings, 32);
+        let bad: u32 = film.nonfinite.iter().chain(&film_rough.nonfinite).chain(&film_beckmann.nonfinite).sum();
         assert_eq!(bad, 0, "NaN/Inf samples");
         let mut m: Vec<(f64, f64)> = [-2.2f32, -1.1, 0.0, 1.1].iter().map(|&cx| sphere_mean(&film, w, h, cx)).collect();
         m.push(sphere_mean(&film_rough, w, h, 0.0));
-        eprintln!("{strategy:?}: (mean, standard error) smooth, thin, α 0.01, diffuse transmission, α 0.3: {m:?}");
+        m.push(sphere_mean(&film_beckmann, w, h, 0.0));
+        eprintln!(
+            "{strategy:?}: (mean, standard error) smooth, thin, α 0.01, diffuse transmission, α 0.3, Beckmann α 0.3: {m:?}"
+        );
         // With BSDF sampling every sample of the lossless objects is 1 up to rounding (σ = 0); MIS adds light
         // samples of the environment (unbiased, not constant): 5σ.
         for (name, (v, se)) in [("smooth glass", m[0]), ("thin glass", m[1]), ("diffuse transmission", m[3])] {
@@ -253,8 +281,17 @@ fn dielectric_white_furnace() {
         let ((a1, se1), (a3, se3)) = (m[2], m[4]);
         assert!(a1 > 0.98 && a1 < 1.0 + 1e-3 + 5.0 * se1, "{strategy:?}: α = 0.01 glass gives {a1} ± {se1}");
         assert!(a3 > 0.7 && a3 < 1.0, "{strategy:?}: α = 0.3 glass gives {a3} ± {se3}");
+        // Beckmann's single scattering loses energy too (its separable G masks more than the height-correlated one).
+        let (b3, sb3) = m[5];
+        assert!(b3 > 0.7 && b3 < 1.0, "{strategy:?}: Beckmann α = 0.3 glass gives {b3} ± {sb3}");
         rough.push(m[4]);
+        beckmann.push(m[5]);
     }
+    let ((b, sb), (l, sl)) = (beckmann[0], beckmann[1]);
+    assert!(
+        (b - l).abs() < 5.0 * (sb * sb + sl * sl).sqrt() + 1e-3,
+        "Beckmann glass: BSDF {b} ± {sb} vs MIS {l} ± {sl}"
+    );
     // BSDF sampling alone and MIS with light sampling (which uses eval and pdf) estimate the same rough sphere.
     let ((b, sb), (l, sl)) = (rough[0], rough[1]);
     assert!((b - l).abs() < 5.0 * (sb * sb + sl * sl).sqrt() + 1e-3, "rough glass: BSDF {b} ± {sb} vs MIS {l} ± {sl}");
@@ -385,7 +422,14 @@ fn toml_dielectric_syntax() {
     let get = |n: &str| s.materials.iter().find(|m| m.name == n).map(|m| m.kind.clone()).expect(n);
     assert_eq!(
         get("glass"),
-        MaterialKind::Dielectric { eta: 1.5, alpha_u: 0.0, alpha_v: 0.0, tint: glam::Vec3::ONE, thin: false }
+        MaterialKind::Dielectric {
+            eta: 1.5,
+            alpha_u: 0.0,
+            alpha_v: 0.0,
+            tint: glam::Vec3::ONE,
+            thin: false,
+            beckmann: false
+        }
     );
     assert!(matches!(get("thin"), MaterialKind::Dielectric { thin: true, .. }));
     assert!(matches!(get("nearly_smooth"), MaterialKind::Dielectric { alpha_u, .. } if alpha_u == 0.01));

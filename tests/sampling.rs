@@ -25,7 +25,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 75;
+const FAMILY: usize = 79;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -1208,6 +1208,25 @@ fn dielectric_cases() -> Vec<Case> {
         c.setup.job.p[3] = eta;
         v.push(c);
     }
+    // Beckmann (specular = 1, Mitsuba's roughdielectric default): wm from D·cos, so some samples face away from wo
+    // and fail; from outside and from inside (with total internal reflection).
+    for (au, av, inc, eta) in [(0.3f32, 0.3f32, 40.0f64, 1.5f32), (0.4, 0.15, 65.0, 1.0 / 1.5)] {
+        let t = deg(inc);
+        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let mut c = bsdf_case(
+            "rough Beckmann dielectric (D·cos + Fresnel choice)",
+            format!("α_u = {au}, α_v = {av}, θo = {inc}°, η = {eta:.3}"),
+            wo,
+            [1.0; 3],
+            0.0,
+            au,
+            1.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [au, 1.0, MATERIAL_DIELECTRIC as f32, av];
+        c.setup.job.p[3] = eta;
+        v.push(c);
+    }
     v
 }
 
@@ -1369,6 +1388,23 @@ fn coated_cases() -> Vec<Case> {
             Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
         );
         c.setup.job.a = [au, 0.0, 3.0, av];
+        v.push(c);
+    }
+    // A Beckmann coat (specular = 1, Mitsuba's roughplastic default): h from D·cos.
+    for (r, au, av, inc) in [(0.5f32, 0.3f32, 0.3f32, 35.0f64), (0.1, 0.1, 0.25, 70.0)] {
+        let t = deg(inc);
+        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let mut c = bsdf_case(
+            "coated diffuse, Beckmann coat (D·cos coat + cosine base)",
+            format!("R = {r}, α_u = {au}, α_v = {av}, θo = {inc}°"),
+            wo,
+            [r, r * 0.5, r * 0.25],
+            0.0,
+            au,
+            1.0,
+            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
+        );
+        c.setup.job.a = [au, 1.0, 3.0, av];
         v.push(c);
     }
     v

@@ -209,7 +209,7 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         },
         emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
         alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
-        specular: if kind.bsdf_kind == MATERIAL_CONDUCTOR {
+        specular: if matches!(kind.bsdf_kind, MATERIAL_CONDUCTOR | MATERIAL_DIELECTRIC | MATERIAL_COATED_DIFFUSE) {
             kind.specular
         } else {
             finite(m.specular, 1.0).clamp(0.0, 1.0)
@@ -247,15 +247,18 @@ fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
         },
         // Reflectance: base_color / base_tex, as for metallic-roughness. η ≥ 1 + 1e-4 (the model has no
         // total internal reflection from outside; η = 1 would be no coat at all).
-        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v } => GpuMaterial {
+        // specular (unused by these kinds' parameters): the microfacet distribution, 0 = GGX, 1 = Beckmann.
+        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v, beckmann } => GpuMaterial {
             bsdf_kind: MATERIAL_COATED_DIFFUSE,
+            specular: if *beckmann { 1.0 } else { 0.0 },
             eta: [finite(*eta, 1.5).clamp(1.0001, 10.0), 1.0, 1.0],
             alpha: alpha(*alpha_u),
             alpha_v: alpha(*alpha_v),
             ..Default::default()
         },
-        MaterialKind::Dielectric { eta, alpha_u, alpha_v, tint, thin } => GpuMaterial {
+        MaterialKind::Dielectric { eta, alpha_u, alpha_v, tint, thin, beckmann } => GpuMaterial {
             bsdf_kind: MATERIAL_DIELECTRIC,
+            specular: if *beckmann { 1.0 } else { 0.0 },
             // η = 1 has no interface to refract at; keep it off 1 so the Walter half vector stays defined.
             // eta[1]: the thin-slab flag.
             eta: {

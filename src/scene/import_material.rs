@@ -155,8 +155,7 @@ pub fn map(
             }
             let (c, t) = color(desc, &["reflectance", "specular_reflectance"], Vec3::ONE, scene, cache)?;
             // Mitsuba's roughconductor is Beckmann unless it says ggx; pbrt-v4's conductor is always GGX.
-            let beckmann = desc.kind == "roughconductor"
-                && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx");
+            let beckmann = desc.kind == "roughconductor" && mitsuba_beckmann(desc, &mut warn);
             let with_distribution = |kind: MaterialKind| match kind {
                 MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, .. } => {
                     MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, beckmann }
@@ -226,11 +225,7 @@ pub fn map(
                 alpha = 0.1;
             }
             let (au, av) = alpha_uv(desc).unwrap_or((alpha, alpha));
-            if desc.kind == "roughdielectric"
-                && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx")
-            {
-                warn("a Beckmann dielectric rendered as GGX of the same α");
-            }
+            let beckmann = desc.kind == "roughdielectric" && mitsuba_beckmann(desc, &mut warn);
             if thin && au.max(av) >= super::DELTA_ALPHA {
                 warn("a smooth thin dielectric (its roughness is dropped)");
             }
@@ -243,8 +238,8 @@ pub fn map(
                 warn("an untextured dielectric");
             }
             let (au, av) = if thin { (0.0, 0.0) } else { (au, av) };
-            let kind = MaterialKind::Dielectric { eta, alpha_u: au, alpha_v: av, tint: tr, thin };
-            Material { kind, base_color: tr, specular: 0.0, ..Default::default() }
+            let kind = MaterialKind::Dielectric { eta, alpha_u: au, alpha_v: av, tint: tr, thin, beckmann };
+            Material { name: desc.name.clone(), kind, base_color: tr, specular: 0.0, ..Default::default() }
         }
         "interface" | "null" => {
             warn("invisible: its shapes are left out (an interface between media, which mislab does not have)");
@@ -315,8 +310,28 @@ fn coated_diffuse(
         if medium {
             warn("its layer medium (thickness/albedo/g) is ignored: the analytic coat has no medium");
         }
-    } else {
-        if !matches!(desc.params.get("nonlinear"), Some(MatParam::Bool(true))) {
+    }
+    // Mitsuba's roughplastic is Beckmann unless it says ggx; pbrt-v4's coat is always GGX; `plastic` is smooth.
+    let beckmann = desc.kind == "roughplastic" && mitsuba_beckmann(desc, &mut warn);
+    let nonlinear = matches!(desc.params.get("nonlinear"), Some(MatParam::Bool(true)));
+    if desc.kind == "roughplastic" {
+        // Mitsuba's diffuse term is r/(1 − F̄ᵢ) (linear) or r/(1 − r·F̄ᵢ) (nonlinear) with ITS internal reflectance,
+        // estimated over the rough interface (smaller than the smooth one this model uses: 0.524 against 0.590
+        // for Beckmann α 0.3): the base is chosen so that this model's R'/(1 − R'·F̄ᵢ) equals that term.
+        let fi = super::coated::coated_internal_reflectance(eta);
+        let fi_m = super::coated::mitsuba_rough_internal_reflectance(eta, au, beckmann);
+        let conv = |r: f32| {
+            let r = r.clamp(0.0, 1.0);
+            let target = if nonlinear { r / (1.0 - r * fi_m) } else { r / (1.0 - fi_m) };
+            super::coated::reflectance_for_diffuse_term(target, fi)
+        };
+        c = Vec3::new(conv(c.x), conv(c.y), conv(c.z));
+        if t.is_some() {
+            warn("Mitsuba's diffuse reflectance of a texture converted at the texture factor");
+        }
+    }
+    if !pbrt {
+        if desc.kind == "plastic" && !nonlinear {
             // Mitsuba's default linear form: its reflectance is the base's share; converted exactly for colours.
             let fi = super::coated::coated_internal_reflectance(eta);
             let lin = |r: f32| super::coated::reflectance_from_linear(r, fi);
@@ -325,20 +340,29 @@ fn coated_diffuse(
                 warn("Mitsuba's linear (nonlinear = false) reflectance of a texture converted at the texture factor");
             }
         }
-        if desc.kind == "roughplastic"
-            && !matches!(desc.params.get("distribution"), Some(MatParam::Str(d)) if d == "ggx")
-        {
-            warn("a Beckmann coat rendered as GGX of the same α");
-        }
         if f("specular_reflectance").is_some_and(|s| s != 1.0) {
             warn("specular_reflectance other than 1 is ignored");
         }
     }
     let m = Material {
-        kind: MaterialKind::CoatedDiffuse { eta, alpha_u: au, alpha_v: av },
+        kind: MaterialKind::CoatedDiffuse { eta, alpha_u: au, alpha_v: av, beckmann },
         ..Material::coated_diffuse(&desc.name, c, eta, au)
     };
     Ok(Mapped::Material(Box::new(with_texture(m, t))))
+}
+
+/// Whether a Mitsuba rough BSDF's `distribution` is Beckmann (its default) rather than `ggx`; any other name
+/// (`phong`) is rendered as Beckmann with a warning.
+fn mitsuba_beckmann(desc: &MaterialDesc, warn: &mut impl FnMut(&str)) -> bool {
+    match desc.params.get("distribution") {
+        Some(MatParam::Str(d)) if d == "ggx" => false,
+        None => true,
+        Some(MatParam::Str(d)) if d == "beckmann" => true,
+        Some(other) => {
+            warn(&format!("Beckmann (its distribution {other:?} is not ggx or beckmann)"));
+            true
+        }
+    }
 }
 
 /// A Mitsuba index of refraction: a number, or one of the names of `NAMED_IORS` (Mitsuba's IOR table).
@@ -533,7 +557,14 @@ mod tests {
         let d = desc("dielectric", vec![("eta", MatParam::Float(1.33)), ("roughness", MatParam::Float(0.04))]);
         assert_eq!(
             kind(&d, &mut s, &mut c, &mut w),
-            MaterialKind::Dielectric { eta: 1.33, alpha_u: 0.2, alpha_v: 0.2, tint: Vec3::ONE, thin: false }
+            MaterialKind::Dielectric {
+                eta: 1.33,
+                alpha_u: 0.2,
+                alpha_v: 0.2,
+                tint: Vec3::ONE,
+                thin: false,
+                beckmann: false
+            }
         );
         let d = desc(
             "dielectric",
@@ -554,7 +585,13 @@ mod tests {
         assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { eta, .. } if eta == 1.333));
         let d = desc("roughdielectric", vec![("distribution", MatParam::Str("ggx".into()))]);
         assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
-            MaterialKind::Dielectric { alpha_u, thin: false, .. } if alpha_u == 0.1));
+            MaterialKind::Dielectric { alpha_u, thin: false, beckmann: false, .. } if alpha_u == 0.1));
+        // Mitsuba's default distribution is Beckmann, rendered as such (no warning).
+        let d = desc("roughdielectric", vec![("alpha", MatParam::Float(0.3))]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
+            MaterialKind::Dielectric { alpha_u, beckmann: true, .. } if alpha_u == 0.3));
+        let d = desc("roughdielectric", vec![("distribution", MatParam::Str("beckmann".into()))]);
+        assert!(matches!(kind(&d, &mut s, &mut c, &mut w), MaterialKind::Dielectric { beckmann: true, .. }));
         let d = desc("thindielectric", vec![]);
         assert!(matches!(kind(&d, &mut s, &mut c, &mut w),
             MaterialKind::Dielectric { thin: true, alpha_u, .. } if alpha_u == 0.0));

@@ -170,17 +170,19 @@ pub enum MaterialKind {
     /// A rough dielectric coat of relative index `eta` over a Lambertian base (pbrt-v4 `coateddiffuse`, Mitsuba
     /// `plastic`/`roughplastic`; shaders/bsdf_coated_diffuse.wgsl). The base's reflectance is the material's
     /// `base_color` times `base_color_texture` (one source for both, as the GPU reads it); the coat is anisotropic
-    /// GGX of α `alpha_u` / `alpha_v` (clamped to `ALPHA_MIN`).
+    /// GGX (or Beckmann) of α `alpha_u` / `alpha_v` (clamped to `ALPHA_MIN`).
     CoatedDiffuse {
         /// Index of refraction of the coat relative to the outside (> 1).
         eta: f32,
-        /// GGX α along the tangent.
+        /// Microfacet α along the tangent.
         alpha_u: f32,
-        /// GGX α along the bitangent.
+        /// Microfacet α along the bitangent.
         alpha_v: f32,
+        /// The coat is Beckmann (Mitsuba 3's roughplastic default) instead of GGX.
+        beckmann: bool,
     },
     /// A dielectric interface (glass, water): Fresnel reflection and refraction with relative index `eta` (inside
-    /// over outside, the side the geometric normal points to being outside), over an anisotropic GGX
+    /// over outside, the side the geometric normal points to being outside), over an anisotropic GGX or Beckmann
     /// microsurface (Walter et al. 2007); `alpha_u`, `alpha_v` below `DELTA_ALPHA` is the smooth interface, an exact
     /// delta reflection + refraction. `tint` multiplies both lobes (1 = non-absorbing).
     Dielectric {
@@ -195,6 +197,8 @@ pub enum MaterialKind {
         /// A thin slab (Mitsuba's `thindielectric`): the slab's summed internal reflections, and transmission
         /// straight through (no bending, no 1/η² scaling); always smooth.
         thin: bool,
+        /// The microsurface is Beckmann (Mitsuba 3's roughdielectric default) instead of GGX.
+        beckmann: bool,
     },
     /// Lambert reflection (`reflectance`, scaled by the base colour texture where the material has one) plus
     /// Lambert transmission to the other side (`transmittance`); pbrt-v4's `diffusetransmission`.
@@ -303,7 +307,7 @@ impl Material {
     pub fn coated_diffuse(name: &str, reflectance: Vec3, eta: f32, alpha: f32) -> Self {
         Material {
             name: name.into(),
-            kind: MaterialKind::CoatedDiffuse { eta, alpha_u: alpha, alpha_v: alpha },
+            kind: MaterialKind::CoatedDiffuse { eta, alpha_u: alpha, alpha_v: alpha, beckmann: false },
             base_color: reflectance,
             ..Default::default()
         }

@@ -23,6 +23,7 @@ pub(super) struct MaterialDef {
     tint: Option<Splat<3>>,
     transmittance: Option<Splat<3>>,
     thin: Option<bool>,
+    distribution: Option<String>,
 }
 
 pub(super) fn material(
@@ -49,14 +50,15 @@ pub(super) fn material(
         ("tint", d.tint.is_some()),
         ("transmittance", d.transmittance.is_some()),
         ("thin", d.thin.is_some()),
+        ("distribution", d.distribution.is_some()),
     ];
     let allowed: &[&str] = match d.kind.as_str() {
         "lambert" => &["reflectance", "emission"],
-        "conductor" => &["reflectance", "alpha", "emission", "eta", "k", "alpha_u", "alpha_v", "tint"],
+        "conductor" => &["reflectance", "alpha", "emission", "eta", "k", "alpha_u", "alpha_v", "tint", "distribution"],
         "metallic-roughness" => &["base_color", "metallic", "roughness", "specular", "emission"],
-        "coated-diffuse" => &["reflectance", "eta", "alpha", "alpha_u", "alpha_v", "emission"],
+        "coated-diffuse" => &["reflectance", "eta", "alpha", "alpha_u", "alpha_v", "emission", "distribution"],
         "emitter" => &["emission"],
-        "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "tint", "thin", "emission"],
+        "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "tint", "thin", "emission", "distribution"],
         "diffuse-transmission" => &["reflectance", "transmittance", "emission"],
         other => {
             return Err(e(&format!(
@@ -83,6 +85,12 @@ pub(super) fn material(
         Ok(x)
     };
     let emission = color("emission", d.emission, 0.0)?;
+    // The microfacet distribution of conductors, dielectrics and coats: "ggx" (the default) or "beckmann".
+    let beckmann = match d.distribution.as_deref() {
+        None | Some("ggx") => false,
+        Some("beckmann") => true,
+        Some(other) => return Err(e(&format!("unknown distribution \"{other}\" (expected \"ggx\" or \"beckmann\")"))),
+    };
     let mut m = match d.kind.as_str() {
         "lambert" => Material::lambert(name, color("reflectance", d.reflectance, 0.8)?),
         "conductor" if d.eta.is_some() || d.k.is_some() => {
@@ -102,17 +110,13 @@ pub(super) fn material(
             }
             Material {
                 name: name.into(),
-                kind: MaterialKind::Conductor {
-                    eta,
-                    k,
-                    alpha_u,
-                    alpha_v,
-                    tint: color("tint", d.tint, 1.0)?,
-                    beckmann: false,
-                },
+                kind: MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint: color("tint", d.tint, 1.0)?, beckmann },
                 base_color: Vec3::ONE,
                 ..Default::default()
             }
+        }
+        "conductor" if beckmann => {
+            return Err(e("'distribution' needs 'eta' and 'k' (the Fresnel-1 conductor is GGX only)"));
         }
         "conductor" if d.alpha_u.is_some() || d.alpha_v.is_some() => {
             return Err(e("'alpha_u'/'alpha_v' need 'eta' and 'k' (the Fresnel-1 conductor is isotropic: 'alpha')"));
@@ -139,7 +143,7 @@ pub(super) fn material(
             let (alpha_u, alpha_v) = (unit("alpha_u", Some(a.0), 0.0)?, unit("alpha_v", Some(a.1), 0.0)?);
             let reflectance = color("reflectance", d.reflectance, 0.5)?;
             Material {
-                kind: MaterialKind::CoatedDiffuse { eta: eta.x, alpha_u, alpha_v },
+                kind: MaterialKind::CoatedDiffuse { eta: eta.x, alpha_u, alpha_v, beckmann },
                 ..Material::coated_diffuse(name, reflectance, eta.x, alpha_u)
             }
         }
@@ -156,11 +160,11 @@ pub(super) fn material(
                 return Err(e("a dielectric's eta must be one positive number (relative index inside/outside)"));
             }
             let thin = d.thin.unwrap_or(false);
-            if thin && alpha_u.max(alpha_v) > 0.0 {
-                return Err(e("a thin dielectric is smooth: it takes no 'alpha'"));
+            if thin && (alpha_u.max(alpha_v) > 0.0 || beckmann) {
+                return Err(e("a thin dielectric is smooth: it takes no 'alpha' or 'distribution'"));
             }
             let tint = color("tint", d.tint, 1.0)?;
-            let kind = MaterialKind::Dielectric { eta: eta.x, alpha_u, alpha_v, tint, thin };
+            let kind = MaterialKind::Dielectric { eta: eta.x, alpha_u, alpha_v, tint, thin, beckmann };
             Material { name: name.into(), kind, base_color: tint, specular: 0.0, ..Default::default() }
         }
         "diffuse-transmission" => {
