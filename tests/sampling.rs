@@ -1186,44 +1186,34 @@ fn chi2_conductor() {
 /// of the lobe is totally reflected), anisotropic and isotropic.
 fn dielectric_cases() -> Vec<Case> {
     let mut v = Vec::new();
-    for (au, av, inc, eta) in [
-        (0.3f32, 0.3f32, 30.0f64, 1.5f32),
-        (0.5, 0.2, 60.0, 1.5),
-        (0.3, 0.3, 45.0, 1.0 / 1.5),
-        (0.25, 0.6, 70.0, 1.0 / 1.5),
+    // GGX (visible normals), then Beckmann (specular = 1, Mitsuba's roughdielectric default: wm from D·cos, so some
+    // samples face away from wo and fail), from outside and from inside (with total internal reflection).
+    for (au, av, inc, eta, beckmann) in [
+        (0.3f32, 0.3f32, 30.0f64, 1.5f32, false),
+        (0.5, 0.2, 60.0, 1.5, false),
+        (0.3, 0.3, 45.0, 1.0 / 1.5, false),
+        (0.25, 0.6, 70.0, 1.0 / 1.5, false),
+        (0.3, 0.3, 40.0, 1.5, true),
+        (0.4, 0.15, 65.0, 1.0 / 1.5, true),
     ] {
         let t = deg(inc);
         let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+        let (name, specular) = if beckmann {
+            ("rough Beckmann dielectric (D·cos + Fresnel choice)", 1.0)
+        } else {
+            ("rough dielectric (VNDF + Fresnel choice)", 0.0)
+        };
         let mut c = bsdf_case(
-            "rough dielectric (VNDF + Fresnel choice)",
+            name,
             format!("α_u = {au}, α_v = {av}, θo = {inc}°, η = {eta:.3}"),
             wo,
             [1.0; 3],
             0.0,
             au,
-            0.0,
+            specular,
             Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
         );
-        c.setup.job.a = [au, 0.0, MATERIAL_DIELECTRIC as f32, av];
-        c.setup.job.p[3] = eta;
-        v.push(c);
-    }
-    // Beckmann (specular = 1, Mitsuba's roughdielectric default): wm from D·cos, so some samples face away from wo
-    // and fail; from outside and from inside (with total internal reflection).
-    for (au, av, inc, eta) in [(0.3f32, 0.3f32, 40.0f64, 1.5f32), (0.4, 0.15, 65.0, 1.0 / 1.5)] {
-        let t = deg(inc);
-        let wo = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
-        let mut c = bsdf_case(
-            "rough Beckmann dielectric (D·cos + Fresnel choice)",
-            format!("α_u = {au}, α_v = {av}, θo = {inc}°, η = {eta:.3}"),
-            wo,
-            [1.0; 3],
-            0.0,
-            au,
-            1.0,
-            Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
-        );
-        c.setup.job.a = [au, 1.0, MATERIAL_DIELECTRIC as f32, av];
+        c.setup.job.a = [au, specular, MATERIAL_DIELECTRIC as f32, av];
         c.setup.job.p[3] = eta;
         v.push(c);
     }
