@@ -8,12 +8,15 @@ mod cases;
 pub use cases::{cases, polygon_irradiance};
 
 use crate::gpu::GpuContext;
+use crate::render::features::PipelineKey;
 use crate::render::film::Film;
 use crate::render::settings::Settings;
 use crate::render::Renderer;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::Scene;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{mpsc, Mutex};
 use std::time::Instant;
 
 /// What a case must show besides zero NaN/Inf samples.
@@ -73,11 +76,11 @@ pub struct Outcome {
     pub pass: bool,
     /// Why not, or what was checked.
     pub detail: String,
-    /// Render seconds (pipeline compilation excluded).
+    /// Render seconds (pipeline compilation excluded; cases render side by side, so this is not a benchmark).
     pub seconds: f64,
 }
 
-/// Renders every case (sharing compiled pipelines between them) and checks it. `filter` keeps the cases whose
+/// Renders every case (on one thread per core, sharing compiled pipelines between them) and checks it. `filter` keeps the cases whose
 /// name contains it (twins are always run). `progress` is called after each case.
 pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Outcome)) -> Result<Vec<Outcome>, String> {
     let all = cases()?;
@@ -93,34 +96,73 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
             })
         })
         .collect();
-    let mut pipelines: HashMap<crate::render::features::PipelineKey, wgpu::ComputePipeline> = HashMap::new();
-    let mut means: HashMap<String, (f64, f64)> = HashMap::new();
-    let mut outcomes = Vec::new();
-    for c in wanted {
-        let o = run_case(ctx, c, &mut pipelines, &means)?;
-        means.insert(c.name.clone(), (o.mean, o.std_error));
-        progress(&o);
-        outcomes.push(o);
-    }
-    Ok(outcomes)
+    // Nearly all of the suite's time is the driver compiling each case's pipeline (a baked scene is its own
+    // shader; lavapipe compiles on one thread), so cases render on one worker per core. They are judged in
+    // list order, as their results arrive, because a `SameAs` case compares with its twin's mean.
+    let pipelines: Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>> = Mutex::new(HashMap::new());
+    let next = AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(wanted.len().max(1));
+    let (tx, rx) = mpsc::channel::<(usize, Result<Rendered, String>)>();
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            let tx = tx.clone();
+            let (wanted, pipelines, next) = (&wanted, &pipelines, &next);
+            scope.spawn(move || loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(c) = wanted.get(i) else { break };
+                let r = render_case(ctx, c, pipelines);
+                let failed = r.is_err();
+                if tx.send((i, r)).is_err() || failed {
+                    // The lead thread stopped listening (it reports the first error), or this worker's case failed:
+                    // no more cases from this worker; `next` past the end stops the others soon.
+                    next.fetch_add(wanted.len(), Ordering::Relaxed);
+                    break;
+                }
+            });
+        }
+        drop(tx);
+        let mut means: HashMap<String, (f64, f64)> = HashMap::new();
+        let mut arrived: Vec<Option<Rendered>> = (0..wanted.len()).map(|_| None).collect();
+        let mut outcomes = Vec::new();
+        for (i, r) in rx.iter() {
+            arrived[i] = Some(r?);
+            while let Some(r) = arrived.get_mut(outcomes.len()).and_then(Option::take) {
+                let c = wanted[outcomes.len()];
+                let o = judge(c, &r.film, r.nonfinite, r.seconds, &means);
+                means.insert(c.name.clone(), (o.mean, o.std_error));
+                progress(&o);
+                outcomes.push(o);
+            }
+        }
+        if outcomes.len() < wanted.len() {
+            return Err(format!("the stress suite stopped after {} of {} cases", outcomes.len(), wanted.len()));
+        }
+        Ok(outcomes)
+    })
 }
 
-fn run_case(
+/// A case's rendered film, its device NaN/Inf count and its render time.
+struct Rendered {
+    film: Film,
+    nonfinite: u64,
+    seconds: f64,
+}
+
+fn render_case(
     ctx: &GpuContext,
     c: &Case,
-    pipelines: &mut HashMap<crate::render::features::PipelineKey, wgpu::ComputePipeline>,
-    means: &HashMap<String, (f64, f64)>,
-) -> Result<Outcome, String> {
+    pipelines: &Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>,
+) -> Result<Rendered, String> {
     let data = SceneData::build(&c.scene);
     let gs = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", c.name))?;
     let mut r = Renderer::new_unprepared(ctx, &gs, c.scene.camera.clone(), c.settings.clone())?;
-    for (k, p) in pipelines.iter() {
+    for (k, p) in pipelines.lock().unwrap_or_else(|e| e.into_inner()).iter() {
         r.insert_pipeline(*k, p.clone());
     }
     r.prepare()?;
     let key = r.key();
     if let Some(p) = r.pipeline(&key) {
-        pipelines.insert(key, p.clone());
+        pipelines.lock().unwrap_or_else(|e| e.into_inner()).insert(key, p.clone());
     }
     r.warm_up(ctx).map_err(|e| e.to_string())?;
     r.set_dispatch_spp(c.dispatch_spp);
@@ -128,7 +170,7 @@ fn run_case(
     r.render(ctx, c.spp).map_err(|e| format!("{}: {e}", c.name))?;
     let seconds = t.elapsed().as_secs_f64();
     let film = r.film(ctx).map_err(|e| format!("{}: {e}", c.name))?;
-    Ok(judge(c, &film, r.nonfinite_total(), seconds, means))
+    Ok(Rendered { film, nonfinite: r.nonfinite_total(), seconds })
 }
 
 /// Image mean and its standard error (from the per-pixel sample variances).
