@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""Issue 13's bar on one bench scene, side by side in one run: Mitsuba 3 renders 16 spp (time T, relMSE E
+against a converged Mitsuba reference); mislab renders the same scene for --time 2T, T and T/2; the table
+says which reach E.
+
+Mitsuba is never a mislab dependency: run this from a scratch venv (`pip install mitsuba==3.9.1 numpy`,
+Debian's libllvm19, DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so). The reference is cached
+(--cache) because it takes 64× the 16-spp time. relMSE = mean of (x − r)² / (r² + 0.01) over pixels and
+channels, as src/testkit/metrics.rs computes it.
+
+  scripts/bar-vs-mitsuba.py ../shared/bench-scenes/damagedhelmet_grey --width 256 --height 256
+"""
+import argparse
+import os
+import pathlib
+import re
+import subprocess
+import sys
+import time
+
+p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+p.add_argument("scene_dir", help="a bench-scene folder holding <stem>.xml and <stem>.toml")
+p.add_argument("--width", type=int, required=True)
+p.add_argument("--height", type=int, required=True)
+p.add_argument("--ref-spp", type=int, default=1024)
+p.add_argument("--mislab", default="target/release/mislab")
+p.add_argument("--cache", default="/tmp/mislab-bar")
+p.add_argument("--threads", type=int, default=2)
+a = p.parse_args()
+
+os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+import numpy as np  # noqa: E402
+
+mi.set_variant("llvm_ad_rgb")
+dr.set_thread_count(a.threads)
+d = pathlib.Path(a.scene_dir)
+stem = d.name
+xml, toml = d / f"{stem}.xml", d / f"{stem}.toml"
+cache = pathlib.Path(a.cache)
+cache.mkdir(parents=True, exist_ok=True)
+
+
+def relmse(x, r):
+    return float(np.mean((x - r) ** 2 / (r * r + 0.01)))
+
+
+scene = mi.load_file(str(xml), width=a.width, height=a.height, max_depth=8, spp=16)
+ref_path = cache / f"{stem}-{a.width}x{a.height}-{a.ref_spp}spp.npy"
+if ref_path.exists():
+    ref = np.load(ref_path)
+else:
+    acc, done, k = None, 0, 0
+    while done < a.ref_spp:
+        n = min(64, a.ref_spp - done)
+        img = np.array(mi.render(scene, spp=n, seed=1000 + k), dtype=np.float64)[:, :, :3]
+        acc = img * n if acc is None else acc + img * n
+        done, k = done + n, k + 1
+    ref = acc / done
+    np.save(ref_path, ref)
+
+np.array(mi.render(scene, spp=1, seed=7))  # warm-up: the JIT compiles the kernel
+t0 = time.perf_counter()
+m16 = np.array(mi.render(scene, spp=16, seed=11), dtype=np.float64)[:, :, :3]
+T = time.perf_counter() - t0
+E = relmse(m16, ref)
+rows = [("Mitsuba 3.9.1 llvm_ad_rgb, 16 spp", T, 16, E)]
+
+for factor, label in ((2.0, "2T"), (1.0, "T"), (0.5, "T/2")):
+    out = cache / f"{stem}-mislab-{label.replace('/', '_')}.exr"
+    cmd = [a.mislab, "render", str(toml), "--mode", "path", "--max-depth", "8", "--strategy", "mis",
+           "--heuristic", "power", "--sampler", "sobol", "--width", str(a.width), "--height", str(a.height),
+           "--time", f"{factor * T:.3f}", "-o", str(out), "--force"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"mislab failed ({r.returncode}): {' '.join(cmd)}\n{r.stderr}")
+    img = np.array(mi.Bitmap(str(out)), dtype=np.float64)[:, :, :3]
+    m = re.search(r"(\d+) spp in ([0-9.]+) s", r.stderr + r.stdout)
+    spp = f"{m.group(1)} ({m.group(2)} s)" if m else "?"
+    rows.append((f"mislab --time {label}", factor * T, spp, relmse(img, ref)))
+
+print(f"{stem} {a.width}x{a.height}, max depth 8, reference Mitsuba {a.ref_spp} spp; E = {E:.4e}")
+print("| renderer | seconds | spp | relMSE | reaches E |\n|---|---|---|---|---|")
+for name, sec, spp, err in rows:
+    print(f"| {name} | {sec:.2f} | {spp} | {err:.4e} | {'yes' if err <= E else 'no'} |")
