@@ -22,9 +22,10 @@ const BVH_LANES: u32 = 64u;
 // Traversal stacks live in workgroup memory, one BVH_STACK_SIZE slice per invocation: lavapipe lowers
 // dynamic indexing of a private (function-scope) array to chains of selects over every element, and a
 // 64-entry private stack made path tracing 1.7× slower than an 8-entry one; workgroup memory is plain
-// addressed memory (and needs no zero-initialisation per call). 2 × 64 × 64 × 4 B = 32 KiB.
+// addressed memory (and needs no zero-initialisation per call). 2 × 64 × 64 × 4 B = 32 KiB. An entry is two
+// words: the BVH2 keeps a reference and its entry distance (f32 bits), the wide tree (bvh_wide.wgsl) a group.
 var<workgroup> bvh_stack_node: array<u32, 4096>;
-var<workgroup> bvh_stack_t: array<f32, 4096>;
+var<workgroup> bvh_stack_aux: array<u32, 4096>;
 /// This invocation's index in its workgroup; entry points that trace call `bvh_set_lane` first.
 var<private> bvh_lane: u32;
 
@@ -243,7 +244,7 @@ fn bvh_pop(base: u32, sp: ptr<function, u32>, t: f32) -> u32 {
         return INVALID;
     }
     *sp -= 1u;
-    return select(INVALID, bvh_stack_node[base + *sp], bvh_stack_t[base + *sp] <= t);
+    return select(INVALID, bvh_stack_node[base + *sp], bitcast<f32>(bvh_stack_aux[base + *sp]) <= t);
 }
 
 /// Stack-based BVH2 traversal shared by trace_closest and trace_any: Aila & Laine 2009's while-while loop with
@@ -266,6 +267,9 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
             return Hit(t_max, select(INVALID, 0u, baked_occluded(r, t_max, skip)), 0.0, 0.0);
         }
         return baked_traverse(r, hit, skip);
+    }
+    if WIDE_BVH {
+        return wide_traverse(r, t_max, any_hit, skip);
     }
     // In a triangle-only scene prim_refs[j] == j (src/accel/bvh.rs into_leaf_order): a leaf's triangles are read
     // directly, with no prim_refs load and no switch on the kind; storage loads dominate a BVH sample on
@@ -294,7 +298,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
                 let far_t = select(tr, tl, right_first);
                 if far_t != F32_MAX && sp < BVH_STACK_SIZE {
                     bvh_stack_node[base + sp] = select(rref, lref, right_first);
-                    bvh_stack_t[base + sp] = far_t;
+                    bvh_stack_aux[base + sp] = bitcast<u32>(far_t);
                     sp += 1u;
                 }
                 next = select(INVALID, select(lref, rref, right_first), near_t != F32_MAX);
