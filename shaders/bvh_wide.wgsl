@@ -80,6 +80,17 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     let bound = 3u * arrayLength(&wide_nodes) + 1u;
     for (var round = 0u; round < bound && ((g.y & WIDE_NODE_BITS) != 0u || tg.y != 0u || sp > 0u); round++) {
         for (var step = 0u; step < bound && ((g.y & WIDE_NODE_BITS) != 0u || (tg.y == 0u && sp > 0u)); step++) {
+            // Pop and step in one iteration: lanes run in lockstep, so an iteration spent only popping idles the
+            // lanes that have a node to visit (the BVH2 loop measured the same).
+            if (g.y & WIDE_NODE_BITS) == 0u {
+                sp -= 1u;
+                let e = vec2<u32>(bvh_stack_node[base + sp], bvh_stack_aux[base + sp]);
+                if (e.y & WIDE_NODE_BITS) != 0u {
+                    g = e;
+                } else {
+                    tg = e;
+                }
+            }
             if (g.y & WIDE_NODE_BITS) != 0u {
                 let bit = countTrailingZeros(g.y & WIDE_NODE_BITS);
                 let slot = (bit - 24u) ^ oct;
@@ -98,14 +109,6 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
                     } else {
                         wide_push(base, &sp, vec2<u32>(node.links.y, prims));
                     }
-                }
-            } else {
-                sp -= 1u;
-                let e = vec2<u32>(bvh_stack_node[base + sp], bvh_stack_aux[base + sp]);
-                if (e.y & WIDE_NODE_BITS) != 0u {
-                    g = e;
-                } else {
-                    tg = e;
                 }
             }
             if bvh_all_lanes(tg.y != 0u) {
