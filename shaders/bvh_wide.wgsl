@@ -68,7 +68,6 @@ fn wide_push(base: u32, sp: ptr<function, u32>, e: vec2<u32>) {
 /// boxes were tested against the closest hit when its node was loaded, and every primitive test uses the current one.
 fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var hit = Hit(t_max, INVALID, 0.0, 0.0);
-    let tri_run = HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS;
     let base = bvh_lane * BVH_STACK_SIZE;
     // Bit k set where the direction is negative: slot i is visited at rank i ^ oct.
     let oct = select(0u, 1u, r.d.x < 0.0) | select(0u, 2u, r.d.y < 0.0) | select(0u, 4u, r.d.z < 0.0);
@@ -117,23 +116,10 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
         }
         // The postponed leaf group's primitives.
         for (var k = 0u; k < 24u && tg.y != 0u; k++) {
-            let j = tg.x + countTrailingZeros(tg.y);
+            let lh = bvh_leaf_test(r, tg.x + countTrailingZeros(tg.y), hit.t, skip);
             tg.y &= tg.y - 1u;
-            var prim: u32;
-            var h = vec4<f32>(0.0);
-            if tri_run {
-                prim = j; // leaf order: prim_refs[j] == j (PRIM_TRIANGLE << 30 | j)
-                if prim != skip {
-                    h = intersect_triangle(r, tri_verts[3u * prim].xyz, tri_verts[3u * prim + 1u].xyz, tri_verts[3u * prim + 2u].xyz, hit.t);
-                }
-            } else {
-                prim = prim_refs[j];
-                if prim != skip {
-                    h = intersect_prim(r, prim, hit.t);
-                }
-            }
-            if h.w != 0.0 && !(HAS_ALPHA && alpha_cut_out(prim, h.y, h.z)) {
-                hit = Hit(h.x, prim, h.y, h.z);
+            if lh.h.w != 0.0 {
+                hit = Hit(lh.h.x, lh.prim, lh.h.y, lh.h.z);
                 if any_hit {
                     return hit;
                 }

@@ -574,6 +574,17 @@ fn helmet() -> Geometry {
 // ---------------------------------------------------------------------------------------------------------------
 // CPU: build invariants
 
+/// The box of an included primitive (by reference), as the builder computes it.
+fn prim_box(g: &Geometry, p: u32) -> bvh::Aabb {
+    let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
+    match p >> 30 {
+        PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]),
+        PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]),
+        _ => bvh::quad_aabb(&g.quads[i]),
+    }
+    .expect("an excluded primitive is in the tree")
+}
+
 /// Every included primitive is referenced once, every box holds what is below it, leaves are small and the depth
 /// fits the GPU stack.
 fn check_structure(g: &Geometry, b: &Bvh) {
@@ -594,13 +605,7 @@ fn check_structure(g: &Geometry, b: &Bvh) {
                 for k in first..first + count {
                     seen[k as usize] += 1;
                     let p = b.prim_refs[k as usize];
-                    let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
-                    let pb = match p >> 30 {
-                        PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]),
-                        PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]),
-                        _ => bvh::quad_aabb(&g.quads[i]),
-                    }
-                    .expect("an excluded primitive is in the tree");
+                    let pb = prim_box(g, p);
                     assert!(bx.contains(&pb), "leaf box does not hold primitive {p:#x}");
                 }
             } else if first != EMPTY_CHILD {
@@ -1032,15 +1037,7 @@ fn check_wide_structure(g: &Geometry, b: &Bvh) {
     use mislab::accel::wide_bvh::{self, WideChild, MAX_NODE_PRIMS, MAX_WIDE_DEPTH, WIDTH};
     assert!(!b.wide.is_empty(), "not a wide tree");
     assert!(wide_bvh::depth(&b.wide) <= MAX_WIDE_DEPTH, "wide depth {}", wide_bvh::depth(&b.wide));
-    let prim_box = |p: u32| {
-        let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
-        match p >> 30 {
-            PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]),
-            PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]),
-            _ => bvh::quad_aabb(&g.quads[i]),
-        }
-        .expect("an excluded primitive is in the tree")
-    };
+    let prim_box = |p: u32| prim_box(g, p);
     let mut seen = vec![0u32; b.prim_refs.len()];
     let mut visited = vec![false; b.wide.len()];
     // Exact box of node n's subtree, checking its children's decoded boxes on the way.
