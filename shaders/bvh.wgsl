@@ -22,9 +22,10 @@ const BVH_LANES: u32 = 64u;
 // Traversal stacks live in workgroup memory, one BVH_STACK_SIZE slice per invocation: lavapipe lowers
 // dynamic indexing of a private (function-scope) array to chains of selects over every element, and a
 // 64-entry private stack made path tracing 1.7× slower than an 8-entry one; workgroup memory is plain
-// addressed memory (and needs no zero-initialisation per call). 2 × 64 × 64 × 4 B = 32 KiB.
+// addressed memory (and needs no zero-initialisation per call). 2 × 64 × 64 × 4 B = 32 KiB. An entry is two
+// words: the BVH2 keeps a reference and its entry distance (f32 bits), the wide tree (bvh_wide.wgsl) a group.
 var<workgroup> bvh_stack_node: array<u32, 4096>;
-var<workgroup> bvh_stack_t: array<f32, 4096>;
+var<workgroup> bvh_stack_aux: array<u32, 4096>;
 /// This invocation's index in its workgroup; entry points that trace call `bvh_set_lane` first.
 var<private> bvh_lane: u32;
 
@@ -243,7 +244,39 @@ fn bvh_pop(base: u32, sp: ptr<function, u32>, t: f32) -> u32 {
         return INVALID;
     }
     *sp -= 1u;
-    return select(INVALID, bvh_stack_node[base + *sp], bvh_stack_t[base + *sp] <= t);
+    return select(INVALID, bvh_stack_node[base + *sp], bitcast<f32>(bvh_stack_aux[base + *sp]) <= t);
+}
+
+/// A leaf primitive's test: its reference and hit (w = 0: a miss, a cut-out point, or `skip`).
+struct LeafHit {
+    prim: u32,
+    h: vec4<f32>,
+}
+
+/// Tests entry j of the leaf order (`prim_refs[j]`) within t; both trees' traversals call it. In a triangle-only
+/// scene prim_refs[j] == j (src/accel/bvh.rs into_leaf_order): the triangle is read directly, with no prim_refs
+/// load and no switch on the kind; storage loads dominate a BVH sample on lavapipe (docs/profile-bvh.md). Chosen
+/// per pipeline, not per leaf: a branch between the two paths costs lavapipe both (measured 13 % slower than
+/// always reading prim_refs).
+fn bvh_leaf_test(r: TraceRay, j: u32, t: f32, skip: u32) -> LeafHit {
+    var prim: u32;
+    var h = vec4<f32>(0.0);
+    if HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS {
+        prim = j; // PRIM_TRIANGLE << 30 | index
+        if prim != skip {
+            h = intersect_triangle(r, tri_verts[3u * prim].xyz, tri_verts[3u * prim + 1u].xyz, tri_verts[3u * prim + 2u].xyz, t);
+        }
+    } else {
+        prim = prim_refs[j];
+        if prim != skip {
+            h = intersect_prim(r, prim, t);
+        }
+    }
+    // A cut-out point is no hit (HAS_ALPHA is false, and this test gone, in scenes without masks).
+    if h.w != 0.0 && HAS_ALPHA && alpha_cut_out(prim, h.y, h.z) {
+        h.w = 0.0;
+    }
+    return LeafHit(prim, h);
 }
 
 /// Stack-based BVH2 traversal shared by trace_closest and trace_any: Aila & Laine 2009's while-while loop with
@@ -267,11 +300,9 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
         }
         return baked_traverse(r, hit, skip);
     }
-    // In a triangle-only scene prim_refs[j] == j (src/accel/bvh.rs into_leaf_order): a leaf's triangles are read
-    // directly, with no prim_refs load and no switch on the kind; storage loads dominate a BVH sample on
-    // lavapipe (docs/profile-bvh.md). Chosen per pipeline, not per leaf: a branch between the two paths costs
-    // lavapipe both (measured 13 % slower than always reading prim_refs).
-    let tri_run = HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS;
+    if WIDE_BVH {
+        return wide_traverse(r, t_max, any_hit, skip);
+    }
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;
     var sp = 0u;
@@ -294,7 +325,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
                 let far_t = select(tr, tl, right_first);
                 if far_t != F32_MAX && sp < BVH_STACK_SIZE {
                     bvh_stack_node[base + sp] = select(rref, lref, right_first);
-                    bvh_stack_t[base + sp] = far_t;
+                    bvh_stack_aux[base + sp] = bitcast<u32>(far_t);
                     sp += 1u;
                 }
                 next = select(INVALID, select(lref, rref, right_first), near_t != F32_MAX);
@@ -317,23 +348,9 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
         }
         // The postponed leaf's primitives, then the leaf `cur` holds if it is one (and so on).
         for (var k = 0u; k < 8u * max_steps && leaf != INVALID; k++) {
-            let j = leaf & BVH_LEAF_FIRST_MASK;
-            var prim: u32;
-            var h = vec4<f32>(0.0);
-            if tri_run {
-                prim = j; // PRIM_TRIANGLE << 30 | index
-                if prim != skip {
-                    h = intersect_triangle(r, tri_verts[3u * prim].xyz, tri_verts[3u * prim + 1u].xyz, tri_verts[3u * prim + 2u].xyz, hit.t);
-                }
-            } else {
-                prim = prim_refs[j];
-                if prim != skip {
-                    h = intersect_prim(r, prim, hit.t);
-                }
-            }
-            // A cut-out point is no hit (HAS_ALPHA is false, and this test gone, in scenes without masks).
-            if h.w != 0.0 && !(HAS_ALPHA && alpha_cut_out(prim, h.y, h.z)) {
-                hit = Hit(h.x, prim, h.y, h.z);
+            let lh = bvh_leaf_test(r, leaf & BVH_LEAF_FIRST_MASK, hit.t, skip);
+            if lh.h.w != 0.0 {
+                hit = Hit(lh.h.x, lh.prim, lh.h.y, lh.h.z);
                 if any_hit {
                     return hit;
                 }

@@ -251,7 +251,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         scene.materials.len(),
         scene.textures.len(),
         data.lights.len(),
-        data.bvh_nodes.len(),
+        data.bvh_node_count(),
         data.bvh_seconds * 1e3,
         data.bvh_bytes() as f64 / (1 << 20) as f64,
         // Per triangle only where there are triangles (the BVH also holds spheres and quads).
@@ -370,7 +370,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
         );
         println!(
             "BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes",
-            data.bvh_nodes.len(),
+            data.bvh_node_count(),
             data.bvh_seconds * 1e3,
             data.bvh_sah,
             data.bvh_bytes()
@@ -378,7 +378,8 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
         // Device memory per triangle: BVH (nodes + references), geometry (vertices) and per-triangle shading data.
         let tris = data.tri_shading.len().max(1) as f64;
         let sizes = mislab::render::gpu_scene::binding_sizes(&data);
-        let (bvh, geom, shading) = (sizes[0] + sizes[1], sizes[2], sizes[5]);
+        let wide = sizes[mislab::render::bindings::WIDE_NODES];
+        let (bvh, geom, shading) = (sizes[0] + sizes[1] + wide, sizes[2], sizes[5]);
         println!(
             "memory per triangle: BVH {:.0} B, geometry {:.0} B, shading {:.0} B, total {:.0} B; every scene buffer {:.1} MiB",
             bvh as f64 / tris,

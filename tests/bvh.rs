@@ -90,7 +90,7 @@ fn probe_source() -> String {
     // Geometry only: no textures, so no cut-outs (alpha.wgsl needs the shading bindings).
     let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
     mislab::render::shaders::compose(
-        &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "baked_geometry.wgsl"],
+        &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "bvh_wide.wgsl", "baked_geometry.wgsl"],
         &format!("{no_alpha}{PROBE_WGSL}"),
     )
 }
@@ -108,6 +108,16 @@ impl Geometry {
     fn build(&self) -> Bvh {
         bvh::build(&self.tris, &self.spheres, &self.quads)
     }
+    fn build_wide(&self) -> Bvh {
+        bvh::build_wide(&self.tris, &self.spheres, &self.quads)
+    }
+}
+
+/// The probe module traversing the 8-wide tree (the pipeline constant a wide scene's pipelines get).
+fn wide_source() -> String {
+    let s = probe_source();
+    assert!(s.contains("override WIDE_BVH: bool = false;"));
+    s.replace("override WIDE_BVH: bool = false;", "override WIDE_BVH: bool = true;")
 }
 
 fn gpu_trace(ctx: &GpuContext, g: &Geometry, bvh: &Bvh, rays: &[ProbeRay]) -> Vec<ProbeTrace> {
@@ -564,6 +574,17 @@ fn helmet() -> Geometry {
 // ---------------------------------------------------------------------------------------------------------------
 // CPU: build invariants
 
+/// The box of an included primitive (by reference), as the builder computes it.
+fn prim_box(g: &Geometry, p: u32) -> bvh::Aabb {
+    let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
+    match p >> 30 {
+        PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]),
+        PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]),
+        _ => bvh::quad_aabb(&g.quads[i]),
+    }
+    .expect("an excluded primitive is in the tree")
+}
+
 /// Every included primitive is referenced once, every box holds what is below it, leaves are small and the depth
 /// fits the GPU stack.
 fn check_structure(g: &Geometry, b: &Bvh) {
@@ -584,13 +605,7 @@ fn check_structure(g: &Geometry, b: &Bvh) {
                 for k in first..first + count {
                     seen[k as usize] += 1;
                     let p = b.prim_refs[k as usize];
-                    let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
-                    let pb = match p >> 30 {
-                        PRIM_TRIANGLE => bvh::triangle_aabb(&g.tris[i]),
-                        PRIM_SPHERE => bvh::sphere_aabb(&g.spheres[i]),
-                        _ => bvh::quad_aabb(&g.quads[i]),
-                    }
-                    .expect("an excluded primitive is in the tree");
+                    let pb = prim_box(g, p);
                     assert!(bx.contains(&pb), "leaf box does not hold primitive {p:#x}");
                 }
             } else if first != EMPTY_CHILD {
@@ -980,30 +995,171 @@ fn gpu_watertight_through_edges_and_vertices() {
     for (center, size) in [(Vec3::ZERO, 1.0f32), (Vec3::new(700.0, -300.0, 1200.0), 50.0)] {
         let tris = closed_mesh(12, size, center, &mut rng);
         let g = Geometry { tris, spheres: vec![], quads: vec![] };
-        let b = g.build();
-        let rays: Vec<(f64, ProbeRay)> = (0..50_000)
-            .map(|k| {
-                let t = g.tris[rng.random_range(0..g.tris.len())];
-                let e = rng.random_range(0..3);
-                // A vertex, or a point on an edge interpolated in f32 as a renderer would.
-                let target = if k % 4 == 0 { t[e] } else { t[e].lerp(t[(e + 1) % 3], rng.random::<f32>()) };
-                let o = center + (unit(&mut rng) * 0.05).as_vec3() * size * rng.random::<f32>();
-                let d = (target - o).normalize();
-                ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
-            })
-            .collect();
-        let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
-        let out = gpu_trace(&ctx, &g, &b, &inputs);
-        let misses = out.iter().filter(|h| h.prim == INVALID).count();
-        let far =
-            out.iter().zip(&rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-4).count();
-        assert_eq!(
-            misses,
-            0,
-            "{misses} of {} rays through edges/vertices leaked (mesh at {center}, size {size})",
-            rays.len()
+        // Both layouts: the BVH2 with 50 000 rays, the wide tree with 20 000.
+        for (b, source, n) in [(g.build(), probe_source(), 50_000), (g.build_wide(), wide_source(), 20_000)] {
+            let rays: Vec<(f64, ProbeRay)> = (0..n)
+                .map(|k| {
+                    let t = g.tris[rng.random_range(0..g.tris.len())];
+                    let e = rng.random_range(0..3);
+                    // A vertex, or a point on an edge interpolated in f32 as a renderer would.
+                    let target = if k % 4 == 0 { t[e] } else { t[e].lerp(t[(e + 1) % 3], rng.random::<f32>()) };
+                    let o = center + (unit(&mut rng) * 0.05).as_vec3() * size * rng.random::<f32>();
+                    let d = (target - o).normalize();
+                    ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
+                })
+                .collect();
+            let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
+            let out = gpu_trace_source(&ctx, &g, &b, &inputs, &source);
+            let misses = out.iter().filter(|h| h.prim == INVALID).count();
+            let far = out
+                .iter()
+                .zip(&rays)
+                .filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-4)
+                .count();
+            assert_eq!(
+                misses,
+                0,
+                "{misses} of {} rays through edges/vertices leaked (mesh at {center}, size {size})",
+                rays.len()
+            );
+            assert_eq!(far, 0, "{far} rays hit away from their aim point (mesh at {center}, size {size})");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The 8-wide compressed BVH (src/accel/wide_bvh.rs, shaders/bvh_wide.wgsl)
+
+/// The wide tree references every included primitive once, each decoded (quantised) child box contains the exact
+/// box of everything below it, leaves fit the 24 primitive bits, interior children follow `child_base` in slot
+/// order, and the depth fits the traversal stack.
+fn check_wide_structure(g: &Geometry, b: &Bvh) {
+    use mislab::accel::wide_bvh::{self, WideChild, MAX_NODE_PRIMS, MAX_WIDE_DEPTH, WIDTH};
+    assert!(!b.wide.is_empty(), "not a wide tree");
+    assert!(wide_bvh::depth(&b.wide) <= MAX_WIDE_DEPTH, "wide depth {}", wide_bvh::depth(&b.wide));
+    let prim_box = |p: u32| prim_box(g, p);
+    let mut seen = vec![0u32; b.prim_refs.len()];
+    let mut visited = vec![false; b.wide.len()];
+    // Exact box of node n's subtree, checking its children's decoded boxes on the way.
+    fn subtree(
+        n: usize,
+        b: &Bvh,
+        seen: &mut [u32],
+        visited: &mut [bool],
+        prim_box: &dyn Fn(u32) -> bvh::Aabb,
+    ) -> bvh::Aabb {
+        assert!(!std::mem::replace(&mut visited[n], true), "wide node {n} reached twice");
+        let node = b.wide[n];
+        let (mut total, mut interior) = (bvh::Aabb::EMPTY, 0);
+        for i in 0..WIDTH {
+            let exact = match node.child(i) {
+                WideChild::Empty => continue,
+                WideChild::Interior(c) => {
+                    assert_eq!(c, node.links[0] + interior, "interior children in slot order");
+                    interior += 1;
+                    subtree(c as usize, b, seen, visited, prim_box)
+                }
+                WideChild::Leaf { first, count } => {
+                    assert!((1..=4).contains(&count) && first - node.links[1] + count <= MAX_NODE_PRIMS);
+                    (first..first + count).fold(bvh::Aabb::EMPTY, |a, k| {
+                        seen[k as usize] += 1;
+                        a.union(&prim_box(b.prim_refs[k as usize]))
+                    })
+                }
+            };
+            assert!(node.child_box(i).contains(&exact), "node {n} slot {i}: quantised box does not hold its child");
+            total = total.union(&exact);
+        }
+        total
+    }
+    subtree(0, b, &mut seen, &mut visited, &prim_box);
+    assert!(visited.iter().all(|&v| v), "unreachable wide nodes");
+    assert!(seen.iter().all(|&c| c == 1), "a primitive reference is not in exactly one leaf");
+    let mut refs = b.prim_refs.clone();
+    refs.sort_unstable();
+    refs.dedup();
+    let included = reference::all_prims(&g.scene()).filter(|&p| is_included(g, p)).count();
+    assert_eq!(refs.len(), included, "every included primitive once");
+}
+
+#[test]
+fn wide_build_invariants() {
+    let p = Vec3::ONE;
+    let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let mut rng = Pcg64::seed_from_u64(8);
+    let huge: Vec<[Vec3; 3]> =
+        (0..2000).map(|_| [v3(&mut rng, -1e30, 1e30), v3(&mut rng, -1e30, 1e30), v3(&mut rng, -1e30, 1e30)]).collect();
+    let tiny: Vec<[Vec3; 3]> = (0..2000)
+        .map(|_| {
+            let c = v3(&mut rng, 1e4, 1e4 + 1.0);
+            [c, c + v3(&mut rng, -1e-3, 1e-3), c + v3(&mut rng, -1e-3, 1e-3)]
+        })
+        .collect();
+    let cases = [
+        ("soup", soup(1)),
+        ("helmet", helmet()),
+        ("empty", Geometry { tris: vec![], spheres: vec![], quads: vec![] }),
+        ("junk", Geometry { tris: vec![[p, p, p]], spheres: vec![], quads: vec![] }),
+        ("one", Geometry { tris: vec![t], spheres: vec![], quads: vec![] }),
+        // (build_pathological_inputs has 20 000; PLOC takes ~15 CPU-s over them.)
+        ("coincident", Geometry { tris: vec![t; 2000], spheres: vec![], quads: vec![] }),
+        ("huge", Geometry { tris: huge, spheres: vec![], quads: vec![] }),
+        ("tiny far from the origin", Geometry { tris: tiny, spheres: vec![], quads: vec![] }),
+    ];
+    for (name, g) in cases {
+        let b = g.build_wide();
+        check_wide_structure(&g, &b);
+        eprintln!(
+            "{name}: {} wide nodes, depth {}, {:.1} bytes/triangle",
+            b.wide.len(),
+            mislab::accel::wide_bvh::depth(&b.wide),
+            b.bytes_per_triangle(),
         );
-        assert_eq!(far, 0, "{far} rays hit away from their aim point (mesh at {center}, size {size})");
+    }
+}
+
+/// The wide traversal's closest and any hits against the f64 reference (soup of all kinds, DamagedHelmet, single
+/// primitives, with and without the subgroup vote), and its closest hits against the BVH2 traversal's.
+#[test]
+fn gpu_wide_traversal_matches_reference_and_bvh2() {
+    let ctx = gpu();
+    let wide = wide_source();
+    let fallback = wide.replace("return b; // BVH_VOTE", "return b;");
+    for (name, g, seed, n) in [("soup", soup(2), 3, 60_000), ("DamagedHelmet", helmet(), 4, 60_000)] {
+        let bw = g.build_wide();
+        let rays = make_rays(&g, n, seed);
+        let refs = reference_hits(&g, &rays);
+        let gw = gpu_trace_source(&ctx, &g, &bw, &rays, &wide);
+        let s = compare(&g, &rays, &gw, &refs, EDGE_MARGIN);
+        check(&format!("{name} (wide)"), &s, 1e-3);
+        assert!(s.hits as f64 > 0.6 * s.rays as f64, "rays should mostly hit");
+        // Same closest hits as the BVH2: the same primitive at the same t, up to ties.
+        let g2 = gpu_trace(&ctx, &g, &g.build(), &rays);
+        let same = gw.iter().zip(&g2).filter(|(a, b)| a.prim == b.prim && a.t == b.t).count();
+        eprintln!("{name}: wide and BVH2 agree on {same} of {} rays", rays.len());
+        assert!(same as f64 >= 0.999 * rays.len() as f64, "wide and BVH2 closest hits differ on {} rays", n - same);
+        // The per-lane vote (devices without subgroups) on a part of the rays.
+        let k = n / 4;
+        let gf = gpu_trace_source(&ctx, &g, &bw, &rays[..k], &fallback);
+        let s = compare(&g, &rays[..k], &gf, &refs[..k], EDGE_MARGIN);
+        check(&format!("{name} (wide, without subgroups)"), &s, 1e-3);
+    }
+    let singles = [
+        Geometry { tris: vec![[Vec3::new(-1.0, -1.0, 0.2), Vec3::X, Vec3::Y]], spheres: vec![], quads: vec![] },
+        Geometry {
+            tris: vec![],
+            spheres: vec![GpuSphere { center: [0.2, -0.1, 0.3], radius: 0.7, ..Default::default() }],
+            quads: vec![],
+        },
+        Geometry { tris: vec![], spheres: vec![], quads: vec![] },
+    ];
+    for (k, g) in singles.iter().enumerate() {
+        let b = g.build_wide();
+        let rays = make_rays(g, 4096, 40 + k as u64);
+        let gpu = gpu_trace_source(&ctx, g, &b, &rays, &wide);
+        let refs: Vec<_> = rays.iter().map(|r| reference::closest(&g.scene(), &ray64(r))).collect();
+        let s = compare(g, &rays, &gpu, &refs, EDGE_MARGIN);
+        check(&format!("wide, single primitive {k}"), &s, 1e-3);
     }
 }
 

@@ -2,6 +2,7 @@
 //! own layout of the WGSL), and every WGSL tag constant equals its Rust enum discriminant. No GPU needed.
 
 use mislab::accel::bvh::GpuBvhNode;
+use mislab::accel::wide_bvh::GpuWideNode;
 use mislab::gpu::types::*;
 use mislab::render::settings::*;
 use std::mem::{offset_of, size_of};
@@ -140,6 +141,7 @@ fn shared_structs_match() {
     );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
     check!(m, "BvhNode", GpuBvhNode, [lmin, l_first, lmax, l_count, rmin, r_first, rmax, r_count]);
+    check!(m, "WideNode", GpuWideNode, [head, links, q_lo_xy, q_lo_z_hi_x, q_hi_yz]);
 }
 
 /// The value of a WGSL `const NAME: u32`.

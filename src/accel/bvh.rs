@@ -18,6 +18,7 @@ use std::time::Instant;
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3, Vec3A};
 
+use crate::accel::wide_bvh::GpuWideNode;
 use crate::gpu::types::{
     make_prim, GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE, PRIM_TRIANGLE,
 };
@@ -57,6 +58,9 @@ pub struct Bvh {
     pub nodes: Vec<GpuBvhNode>,
     /// Primitive references (`kind << 30 | index`) in leaf order; excluded primitives are absent.
     pub prim_refs: Vec<u32>,
+    /// The 8-wide compressed nodes ([`crate::accel::wide_bvh::widen`]), root first; empty for the binary layout.
+    /// When not empty, they are the tree (`nodes` is then one empty root) and `prim_refs` are in their leaf order.
+    pub wide: Vec<GpuWideNode>,
     /// Wall-clock time of [`build`] (boxes, obvhs, flattening).
     pub build_seconds: f64,
     /// SAH cost (traversal cost 1, intersection cost 1, areas relative to the root box); 0 for an empty tree.
@@ -75,7 +79,9 @@ impl Bvh {
         if tris == 0 {
             return 0.0;
         }
-        let bytes = std::mem::size_of_val(self.nodes.as_slice()) + std::mem::size_of_val(self.prim_refs.as_slice());
+        let bytes = std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.prim_refs.as_slice())
+            + std::mem::size_of_val(self.wide.as_slice());
         bytes as f64 / tris as f64
     }
 
@@ -244,6 +250,20 @@ struct TmpNode {
 /// as in the `tri_verts` buffer); excluded primitives (see [`triangle_aabb`], [`sphere_aabb`], [`quad_aabb`]) are
 /// not in the tree and can never be hit. Panics if a kind has more than 2^30 primitives.
 pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad]) -> Bvh {
+    build_with(tri_verts, spheres, quads, false)
+}
+
+/// [`build`] collapsed to the 8-wide compressed layout ([`crate::accel::wide_bvh::widen`]). Where the wide tree of
+/// the PLOC build would be too deep for the traversal stack, the median split's tree (depth ≤ 31 for any input
+/// size the references allow) is widened instead.
+pub fn build_wide(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad]) -> Bvh {
+    crate::accel::wide_bvh::widen(&build(tri_verts, spheres, quads)).unwrap_or_else(|| {
+        crate::accel::wide_bvh::widen(&build_with(tri_verts, spheres, quads, true))
+            .expect("a median-split tree is shallow enough to widen")
+    })
+}
+
+fn build_with(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], median: bool) -> Bvh {
     let start = Instant::now();
     for n in [tri_verts.len(), spheres.len(), quads.len()] {
         assert!(n as u64 <= PRIM_INDEX_MASK as u64 + 1, "a BVH holds at most 2^30 primitives of each kind");
@@ -264,7 +284,7 @@ pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad]) 
     let (tmp, order) = if boxes.is_empty() {
         (Vec::new(), Vec::new())
     } else {
-        let (tmp, order) = build_obvhs(&boxes);
+        let (tmp, order) = if median { build_median(&boxes) } else { build_obvhs(&boxes) };
         if tree_depth(&tmp) <= BVH_STACK_SIZE {
             (tmp, order)
         } else {
@@ -389,7 +409,7 @@ fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh 
         r_count: 0,
     };
     if tmp.is_empty() {
-        return Bvh { nodes: vec![empty_node], prim_refs: Vec::new(), build_seconds: 0.0, sah_cost: 0.0 };
+        return Bvh { nodes: vec![empty_node], ..Default::default() };
     }
 
     // Boxes bottom-up: children always have larger tmp indices than their parent, so a reverse sweep works.
@@ -417,7 +437,7 @@ fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh 
         let b = tbox[0];
         prim_refs.extend(order[t.first as usize..(t.first + t.count) as usize].iter().map(|&p| refs[p as usize]));
         nodes.push(GpuBvhNode { lmin: b.min.into(), l_first: 0, lmax: b.max.into(), l_count: t.count, ..empty_node });
-        return Bvh { nodes, prim_refs, build_seconds: 0.0, sah_cost: t.count as f32 };
+        return Bvh { nodes, prim_refs, sah_cost: t.count as f32, ..Default::default() };
     }
 
     // Preorder: pop a tmp interior node, give it the next output index, patch its parent's link.
@@ -461,7 +481,7 @@ fn flatten(tmp: &[TmpNode], order: &[u32], refs: &[u32], boxes: &[Aabb]) -> Bvh 
             stack.push((c, out as usize, side));
         }
     }
-    Bvh { nodes, prim_refs, build_seconds: 0.0, sah_cost: sah as f32 }
+    Bvh { nodes, prim_refs, sah_cost: sah as f32, ..Default::default() }
 }
 
 /// CPU reference intersection in f64: every primitive, no acceleration structure. For tests (the thing under test

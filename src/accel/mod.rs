@@ -1,6 +1,7 @@
-//! Acceleration structures built on the CPU for the device: the BVH over primitives, the convex solids of tiny
-//! scenes, and the light tree over emitters.
+//! Acceleration structures built on the CPU for the device: the BVH over primitives (binary, and its 8-wide
+//! compressed collapse), the convex solids of tiny scenes, and the light tree over emitters.
 
 pub mod bvh;
 pub mod convex_solids;
 pub mod light_tree;
+pub mod wide_bvh;

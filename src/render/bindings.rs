@@ -5,6 +5,7 @@
 
 use crate::accel::bvh::GpuBvhNode;
 use crate::accel::light_tree::GpuLightNode;
+use crate::accel::wide_bvh::GpuWideNode;
 use crate::gpu::types::*;
 use crate::render::scene_data::SceneData;
 
@@ -59,11 +60,24 @@ const fn scene(
     Binding { group: 0, binding, name, wgsl_type, access: Access::Read, element_size, label, note: "" }
 }
 
-/// Bindings 0–4 of group 0 are the geometry (what BVH traversal reads; the probe kernels bind these alone).
+/// Bindings 0–4 of group 0 and [`WIDE_NODES`] are the geometry (what BVH traversal reads; the probe kernels bind
+/// these alone).
 pub const GEOMETRY_BINDINGS: u32 = 5;
+/// The binding (and `SCENE` index) of the wide BVH's nodes, a geometry binding added after the shading ones.
+pub const WIDE_NODES: usize = 14;
+
+/// The geometry bindings of group 0, in binding order.
+pub fn geometry() -> impl Iterator<Item = &'static SceneBinding> {
+    SCENE[..GEOMETRY_BINDINGS as usize].iter().chain(std::iter::once(&SCENE[WIDE_NODES]))
+}
+
+/// The other bindings of group 0 (materials, lights, textures, environment).
+pub fn shading() -> impl Iterator<Item = &'static SceneBinding> {
+    SCENE.iter().enumerate().filter(|(i, _)| *i >= GEOMETRY_BINDINGS as usize && *i != WIDE_NODES).map(|(_, b)| b)
+}
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 14] = [
+pub const SCENE: [SceneBinding; 15] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -122,6 +136,13 @@ pub const SCENE: [SceneBinding; 14] = [
     SceneBinding {
         binding: scene(13, "light_tree", "array<LightNode>", size_of::<GpuLightNode>(), "light tree"),
         bytes: |d| bytemuck::cast_slice(&d.light_tree),
+    },
+    SceneBinding {
+        binding: Binding {
+            note: "8-wide compressed BVH nodes (src/accel/wide_bvh.rs); one zero node where the scene uses bvh_nodes.",
+            ..scene(14, "wide_nodes", "array<WideNode>", size_of::<GpuWideNode>(), "wide BVH nodes")
+        },
+        bytes: |d| bytemuck::cast_slice(&d.wide_nodes),
     },
 ];
 
@@ -187,11 +208,11 @@ pub fn wgsl_declaration(b: &Binding) -> String {
     format!("{note}@group({}) @binding({}) {var} {}: {};\n", b.group, b.binding, b.name, b.wgsl_type)
 }
 
-/// `geometry_bindings.wgsl`: the geometry bindings (group 0, 0–4), for BVH traversal.
+/// `geometry_bindings.wgsl`: the geometry bindings (group 0, 0–4 and 14), for BVH traversal.
 pub fn geometry_wgsl() -> String {
     let mut s =
         String::from("// geometry_bindings.wgsl — generated from src/render/bindings.rs: the scene's geometry.\n\n");
-    for b in &SCENE[..GEOMETRY_BINDINGS as usize] {
+    for b in geometry() {
         s += &wgsl_declaration(&b.binding);
     }
     s
@@ -203,7 +224,7 @@ pub fn shading_wgsl() -> String {
         "// shading_bindings.wgsl — generated from src/render/bindings.rs: materials, lights, textures, environment\n\
          // (group 0) and the per-render state (group 1).\n\n",
     );
-    for b in &SCENE[GEOMETRY_BINDINGS as usize..] {
+    for b in shading() {
         s += &wgsl_declaration(&b.binding);
     }
     s += "\n";

@@ -57,6 +57,8 @@ pub struct Features {
     pub many_lights: bool,
     /// Any triangle with a cut-out mask (shaders/alpha.wgsl): the traversal tests alpha at triangle hits.
     pub alpha: bool,
+    /// The scene's BVH is the 8-wide compressed one (shaders/bvh_wide.wgsl), not the BVH2.
+    pub wide_bvh: bool,
     /// For scenes of at most `FLAT_MAX_PRIMS` primitives: (triangles, spheres, quads), baked into the shader
     /// (src/render/baked.rs): every primitive tested, unrolled, with its data as literals, instead of a BVH walk (no
     /// stack, no divergent traversal, no buffer reads). None = BVH.
@@ -87,6 +89,8 @@ impl Features {
             dielectric: true,
             diffuse_transmission: true,
             many_lights: true,
+            // Not a code path but the layout every scene of this process is built with (SceneData::build).
+            wide_bvh: crate::render::scene_data::bvh_layout_wide(),
             alpha: true,
             flat: None,
             baked: 0,
@@ -122,6 +126,7 @@ impl Features {
             dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
             diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
             many_lights: data.lights.len() > 1,
+            wide_bvh: !data.wide_nodes.is_empty(),
             alpha,
             // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
             flat: crate::render::baked::flat_counts(data).filter(|_| !alpha),
@@ -157,6 +162,7 @@ impl Features {
             ("MANY_LIGHTS", b(self.many_lights)),
             ("HAS_ALPHA", b(self.alpha)),
             ("FLAT_SCENE", b(self.flat.is_some())),
+            ("WIDE_BVH", b(self.wide_bvh)),
         ]
     }
 
@@ -185,6 +191,7 @@ impl Features {
         on("diffuse transmission", self.diffuse_transmission);
         on("light selection", self.many_lights);
         on("alpha cut-outs", self.alpha);
+        on("8-wide compressed BVH", self.wide_bvh && self.flat.is_none());
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));
         }

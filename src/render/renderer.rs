@@ -26,6 +26,7 @@ pub const RENDER_FILES: &[&str] = &[
     "samplers.wgsl",
     "warps.wgsl",
     "bvh.wgsl",
+    "bvh_wide.wgsl",
     "baked_geometry.wgsl",
     "scene_data.wgsl",
     "bsdf_conductor.wgsl",

@@ -50,6 +50,9 @@ pub struct SceneData {
     pub bvh_nodes: Vec<bvh::GpuBvhNode>,
     /// BVH primitive references.
     pub prim_refs: Vec<u32>,
+    /// The 8-wide compressed BVH's nodes; empty where the scene uses the BVH2 (`bvh_nodes`). When not empty,
+    /// `bvh_nodes` is one empty root and `prim_refs` follow the wide tree's leaves.
+    pub wide_nodes: Vec<crate::accel::wide_bvh::GpuWideNode>,
     /// BVH build time, seconds.
     pub bvh_seconds: f64,
     /// BVH SAH cost.
@@ -155,7 +158,11 @@ impl SceneData {
             }
         }
         d.offset_scale = if extent.is_finite() && extent > 0.0 { extent.clamp(1e-30, 1.0) } else { 1.0 };
-        let mut bvh = bvh::build(&tris, &d.spheres, &d.quads);
+        let mut bvh = if bvh_layout_wide() {
+            bvh::build_wide(&tris, &d.spheres, &d.quads)
+        } else {
+            bvh::build(&tris, &d.spheres, &d.quads)
+        };
         // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs.
         let order = bvh::into_leaf_order(&mut bvh, tris.len());
         tris = order.iter().map(|&i| tris[i as usize]).collect();
@@ -165,15 +172,32 @@ impl SceneData {
         d.bvh_sah = bvh.sah_cost;
         d.bvh_nodes = bvh.nodes;
         d.prim_refs = bvh.prim_refs;
+        d.wide_nodes = bvh.wide;
         build_textures(scene, &mut d);
         build_lights(scene, &tris, &mut d);
         d
     }
 
+    /// Nodes of the BVH in use, and its kind ("8-wide" or "binary").
+    pub fn bvh_node_count(&self) -> String {
+        match self.wide_nodes.len() {
+            0 => format!("{} binary", self.bvh_nodes.len()),
+            n => format!("{n} 8-wide"),
+        }
+    }
+
     /// Bytes of geometry + BVH per triangle (0 without triangles).
     pub fn bvh_bytes(&self) -> usize {
-        self.bvh_nodes.len() * std::mem::size_of::<bvh::GpuBvhNode>() + self.prim_refs.len() * 4
+        self.bvh_nodes.len() * std::mem::size_of::<bvh::GpuBvhNode>()
+            + self.prim_refs.len() * 4
+            + std::mem::size_of_val(self.wide_nodes.as_slice())
     }
+}
+
+/// Whether scenes get the 8-wide compressed BVH (the default) or the BVH2: `MISLAB_BVH=2` selects the BVH2, for
+/// A/B runs and as the fallback to compare against (docs/profile-bvh.md).
+pub fn bvh_layout_wide() -> bool {
+    std::env::var("MISLAB_BVH").map_or(true, |v| v != "2")
 }
 
 fn xform(t: &Option<TextureRef>) -> ([f32; 4], [f32; 4], u32) {

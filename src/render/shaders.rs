@@ -5,6 +5,7 @@
 pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
+    ("bvh_wide.wgsl", include_str!("../../shaders/bvh_wide.wgsl")),
     ("baked_geometry.wgsl", include_str!("../../shaders/baked_geometry.wgsl")),
     ("scene_data.wgsl", include_str!("../../shaders/scene_data.wgsl")),
     ("specialize.wgsl", include_str!("../../shaders/specialize.wgsl")),

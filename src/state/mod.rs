@@ -163,6 +163,7 @@ pub fn scene_hash(data: &SceneData, camera: &Camera) -> String {
     h.write_pod(&data.origin.to_array());
     h.write_pod(&data.bvh_nodes);
     h.write_pod(&data.prim_refs);
+    h.write_pod(&data.wide_nodes);
     for v in [camera.position, camera.forward, camera.up] {
         h.write_pod(&v.to_array());
     }

@@ -3,7 +3,7 @@
 //!
 //! Binding convention (the pipeline layout is explicit, so a shader may use any subset of it):
 //! - `@group(0)`: the scene geometry exactly as `geometry_bindings.wgsl` declares it (bindings 0–4: `bvh_nodes`,
-//!   `prim_refs`, `tri_verts`, `spheres`, `quads`, all `var<storage, read>`). Present only when the job has a
+//!   `prim_refs`, `tri_verts`, `spheres`, `quads`, and 14: `wide_nodes`, all `var<storage, read>`). Present only when the job has a
 //!   [`GeometryBuffers`]; without one the shader must not declare group 0.
 //! - `@group(1)` ([`PROBE_GROUP`]): `@binding(0)` the output, `var<storage, read_write>`, pre-filled with
 //!   [`PROBE_SENTINEL`] words so unwritten results are recognisable (a NaN as f32); `@binding(1 + k)` the k-th input,
@@ -42,13 +42,14 @@ pub enum ProbeError {
     Gpu(#[from] GpuError),
 }
 
-/// The five geometry storage buffers of `geometry_bindings.wgsl` (group 0).
+/// The six geometry storage buffers of `geometry_bindings.wgsl` (group 0).
 pub struct GeometryBuffers {
     pub bvh_nodes: wgpu::Buffer,
     pub prim_refs: wgpu::Buffer,
     pub tri_verts: wgpu::Buffer,
     pub spheres: wgpu::Buffer,
     pub quads: wgpu::Buffer,
+    pub wide_nodes: wgpu::Buffer,
 }
 
 impl GeometryBuffers {
@@ -63,11 +64,13 @@ impl GeometryBuffers {
             tri_verts: ctx.storage_buffer("tri_verts", &verts, none),
             spheres: ctx.storage_buffer("spheres", spheres, none),
             quads: ctx.storage_buffer("quads", quads, none),
+            wide_nodes: ctx.storage_buffer("wide_nodes", &bvh.wide, none),
         }
     }
 
-    fn buffers(&self) -> [&wgpu::Buffer; 5] {
-        [&self.bvh_nodes, &self.prim_refs, &self.tri_verts, &self.spheres, &self.quads]
+    /// In the order of `bindings::geometry()`.
+    fn buffers(&self) -> [&wgpu::Buffer; 6] {
+        [&self.bvh_nodes, &self.prim_refs, &self.tri_verts, &self.spheres, &self.quads, &self.wide_nodes]
     }
 }
 
@@ -122,8 +125,7 @@ impl<'a> Probe<'a> {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
 
         let geometry_layout = job.geometry.map(|_| {
-            let geometry = &bindings::SCENE[..bindings::GEOMETRY_BINDINGS as usize];
-            let entries: Vec<_> = geometry.iter().map(|b| bindings::layout_entry(&b.binding)).collect();
+            let entries: Vec<_> = bindings::geometry().map(|b| bindings::layout_entry(&b.binding)).collect();
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("probe geometry"),
                 entries: &entries,
@@ -175,8 +177,8 @@ impl<'a> Probe<'a> {
             let entries: Vec<_> = g
                 .buffers()
                 .iter()
-                .enumerate()
-                .map(|(b, buf)| wgpu::BindGroupEntry { binding: b as u32, resource: buf.as_entire_binding() })
+                .zip(bindings::geometry())
+                .map(|(buf, b)| wgpu::BindGroupEntry { binding: b.binding.binding, resource: buf.as_entire_binding() })
                 .collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("probe geometry"),

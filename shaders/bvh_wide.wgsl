@@ -1,0 +1,130 @@
+// bvh_wide.wgsl — traversal of the 8-wide compressed BVH (src/accel/wide_bvh.rs; Ylitie, Karras, Laine 2017).
+// Needs bvh.wgsl (TraceRay, ray_box_entry, the primitive tests, the traversal stacks and the subgroup vote).
+
+/// Whether this pipeline traverses the wide tree (`wide_nodes`) instead of the BVH2 (`bvh_nodes`): set per
+/// pipeline from the scene (src/render/features.rs), so only one traversal is compiled in.
+override WIDE_BVH: bool = false;
+
+/// One 8-wide node, 80 bytes as five vec4 (mirrors `GpuWideNode` in src/accel/wide_bvh.rs, whose module docs give
+/// the encoding): five loads per node step, each testing eight quantised boxes.
+struct WideNode {
+    head: vec4<u32>,
+    links: vec4<u32>,
+    q_lo_xy: vec4<u32>,
+    q_lo_z_hi_x: vec4<u32>,
+    q_hi_yz: vec4<u32>,
+}
+
+/// Bits 24–31 of a hit mask: interior children, by visiting rank. Bits 0–23: leaf primitives.
+const WIDE_NODE_BITS: u32 = 0xff000000u;
+
+/// The 8-bit values of slots 4·half .. 4·half + 3 from a (slots 0–3, slots 4–7) word pair.
+fn wide_bytes(w: vec2<u32>, half: u32) -> u32 {
+    return select(w.x, w.y, half == 1u);
+}
+
+/// Which children of `n` the ray enters within t: for an interior child in slot i the bit 24 + (i ^ oct) (its
+/// visiting rank), for a leaf its primitives' bits offset .. offset + count − 1. The decoded boxes are
+/// conservative (src/accel/wide_bvh.rs), so the robust slab test misses nothing the BVH2 would find.
+fn wide_node_hits(r: TraceRay, oct: u32, n: WideNode, t: f32) -> u32 {
+    let p = bitcast<vec3<f32>>(n.head.xyz);
+    let e = (vec3<u32>(n.head.w) >> vec3<u32>(0u, 8u, 16u)) & vec3<u32>(0xffu);
+    let s = bitcast<vec3<f32>>(e << vec3<u32>(23u));
+    var hits = 0u;
+    for (var half = 0u; half < 2u; half++) {
+        let meta_w = wide_bytes(n.links.zw, half);
+        let lo_w = vec3<u32>(wide_bytes(n.q_lo_xy.xy, half), wide_bytes(n.q_lo_xy.zw, half), wide_bytes(n.q_lo_z_hi_x.xy, half));
+        let hi_w = vec3<u32>(wide_bytes(n.q_lo_z_hi_x.zw, half), wide_bytes(n.q_hi_yz.xy, half), wide_bytes(n.q_hi_yz.zw, half));
+        for (var k = 0u; k < 4u; k++) {
+            let sh = 8u * k;
+            let m = (meta_w >> sh) & 0xffu;
+            // s·q is exact (a power of two times a byte), so p + s·q rounds once, as on the CPU.
+            let lo = p + s * vec3<f32>((lo_w >> vec3<u32>(sh)) & vec3<u32>(0xffu));
+            let hi = p + s * vec3<f32>((hi_w >> vec3<u32>(sh)) & vec3<u32>(0xffu));
+            let entered = ray_box_entry(r, lo, hi, t) != F32_MAX;
+            let count = m >> 5u;
+            let slot = 4u * half + k;
+            let bits = select(((1u << count) - 1u) << (m & 31u), 1u << (24u + (slot ^ oct)), count == 0u);
+            hits |= select(0u, bits, entered && m != 0u);
+        }
+    }
+    return hits;
+}
+
+fn wide_push(base: u32, sp: ptr<function, u32>, e: vec2<u32>) {
+    // src/accel/wide_bvh.rs keeps 2 · depth ≤ BVH_STACK_SIZE, so this never drops an entry.
+    if *sp < BVH_STACK_SIZE {
+        bvh_stack_node[base + *sp] = e.x;
+        bvh_stack_aux[base + *sp] = e.y;
+        *sp += 1u;
+    }
+}
+
+/// Closest or any hit in the wide tree: the paper's traversal with node groups and leaf groups. A node group is
+/// (child_base, interior hit bits | imask): the next child is the lowest rank left, and the rest of the group is
+/// pushed before descending. A leaf group is (tri_base, primitive hit bits). As in `bvh_traverse`, a lane that finds
+/// leaf primitives postpones them (pushing a second group) and keeps traversing until every lane of its subgroup has
+/// some; then all test them together, one primitive per iteration. Stack entries carry no distance: a group's
+/// boxes were tested against the closest hit when its node was loaded, and every primitive test uses the current one.
+fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
+    var hit = Hit(t_max, INVALID, 0.0, 0.0);
+    let base = bvh_lane * BVH_STACK_SIZE;
+    // Bit k set where the direction is negative: slot i is visited at rank i ^ oct.
+    let oct = select(0u, 1u, r.d.x < 0.0) | select(0u, 2u, r.d.y < 0.0) | select(0u, 4u, r.d.z < 0.0);
+    // The root as a node group of one: rank oct is slot 0, and imask 0 makes it child_base + 0.
+    var g = vec2<u32>(0u, 1u << (24u + oct));
+    var tg = vec2<u32>(0u, 0u);
+    var sp = 0u;
+    // Every node is loaded at most once and pushes at most two entries: these bound both loops.
+    let bound = 3u * arrayLength(&wide_nodes) + 1u;
+    for (var round = 0u; round < bound && ((g.y & WIDE_NODE_BITS) != 0u || tg.y != 0u || sp > 0u); round++) {
+        for (var step = 0u; step < bound && ((g.y & WIDE_NODE_BITS) != 0u || (tg.y == 0u && sp > 0u)); step++) {
+            // Pop and step in one iteration: lanes run in lockstep, so an iteration spent only popping idles the
+            // lanes that have a node to visit (the BVH2 loop measured the same).
+            if (g.y & WIDE_NODE_BITS) == 0u {
+                sp -= 1u;
+                let e = vec2<u32>(bvh_stack_node[base + sp], bvh_stack_aux[base + sp]);
+                if (e.y & WIDE_NODE_BITS) != 0u {
+                    g = e;
+                } else {
+                    tg = e;
+                }
+            }
+            if (g.y & WIDE_NODE_BITS) != 0u {
+                let bit = countTrailingZeros(g.y & WIDE_NODE_BITS);
+                let slot = (bit - 24u) ^ oct;
+                let idx = g.x + countOneBits(g.y & ((1u << slot) - 1u));
+                g.y &= ~(1u << bit);
+                if (g.y & WIDE_NODE_BITS) != 0u {
+                    wide_push(base, &sp, g);
+                }
+                let node = wide_nodes[idx];
+                let hits = wide_node_hits(r, oct, node, hit.t);
+                g = vec2<u32>(node.links.x, (hits & WIDE_NODE_BITS) | (node.head.w >> 24u));
+                let prims = hits & ~WIDE_NODE_BITS;
+                if prims != 0u {
+                    if tg.y == 0u {
+                        tg = vec2<u32>(node.links.y, prims);
+                    } else {
+                        wide_push(base, &sp, vec2<u32>(node.links.y, prims));
+                    }
+                }
+            }
+            if bvh_all_lanes(tg.y != 0u) {
+                break;
+            }
+        }
+        // The postponed leaf group's primitives.
+        for (var k = 0u; k < 24u && tg.y != 0u; k++) {
+            let lh = bvh_leaf_test(r, tg.x + countTrailingZeros(tg.y), hit.t, skip);
+            tg.y &= tg.y - 1u;
+            if lh.h.w != 0.0 {
+                hit = Hit(lh.h.x, lh.prim, lh.h.y, lh.h.z);
+                if any_hit {
+                    return hit;
+                }
+            }
+        }
+    }
+    return hit;
+}

@@ -1,0 +1,340 @@
+//! An 8-wide BVH with child boxes quantised to 8 bits (Ylitie, Karras, Laine 2017, "Efficient Incoherent Ray
+//! Traversal on GPUs Through Compressed Wide BVHs"), collapsed from the BVH2 of [`crate::accel::bvh`]. One node
+//! is 80 bytes (five vec4 loads on the GPU) and tests eight boxes, so a ray makes fewer node steps; storage-buffer
+//! loads dominate a BVH sample on lavapipe (docs/profile-bvh.md).
+//!
+//! Layout ([`GpuWideNode`], WGSL `WideNode` in `shaders/bvh_wide.wgsl`):
+//! - `head`: the node's origin `p` (f32 bits, xyz) and, in w, the three biased exponents of the per-axis
+//!   power-of-two scale `s = 2^(e − 127)` (bytes 0–2) and `imask` (byte 3: bit i set = slot i is an interior node);
+//! - `links`: `child_base` (index of the first interior child; interior children follow in slot order),
+//!   `tri_base` (index into `prim_refs` of the first primitive of the leaf children), and the eight `meta` bytes;
+//! - `q_lo_xy`, `q_lo_z_hi_x`, `q_hi_yz`: per slot and axis, 8-bit `q` with the child's box edge at `p + s·q`
+//!   (words hold slots 0–3, then 4–7, one byte each).
+//!
+//! `meta` of a slot: 0 = empty; `24 + slot` = interior; `count << 5 | offset` = a leaf over
+//! `prim_refs[tri_base + offset ..][..count]` (count 1..=4, offset + count ≤ 24: the traversal keeps one hit bit per
+//! primitive in bits 0–23 and one per interior slot in bits 24–31).
+//!
+//! Slots are ordered by position: bit k of a child's slot is set when the child lies on the + side of axis k of its
+//! parent. A ray visits slot `rank ^ octant` at `rank` = 0, 1, …, 7, with bit k of `octant` set where the direction
+//! is negative: near children first without sorting by distance.
+//!
+//! Quantisation is conservative: the decoded box, evaluated in f32 exactly as the shader does (`p + s·q`; `s·q` is
+//! exact, so an fma gives the same bits), contains the child's box, so the wide tree finds the same closest hits.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use crate::accel::bvh::{Aabb, Bvh, GpuBvhNode, BVH_STACK_SIZE, EMPTY_CHILD, MAX_LEAF_PRIMS};
+
+/// One 8-wide node (WGSL `WideNode`, same field names); see the module docs.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuWideNode {
+    pub head: [u32; 4],
+    pub links: [u32; 4],
+    pub q_lo_xy: [u32; 4],
+    pub q_lo_z_hi_x: [u32; 4],
+    pub q_hi_yz: [u32; 4],
+}
+
+/// Children per node.
+pub const WIDTH: usize = 8;
+/// Primitive hit bits per node (bits 0–23 of the traversal's hit mask).
+pub const MAX_NODE_PRIMS: u32 = 24;
+/// Most wide levels: the traversal stack holds at most two entries per level (the rest of a node group and a
+/// postponed leaf group), so `2 · depth ≤ BVH_STACK_SIZE`.
+pub const MAX_WIDE_DEPTH: usize = BVH_STACK_SIZE / 2;
+
+/// A decoded child of a wide node (for tests and statistics).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WideChild {
+    Empty,
+    /// An interior node: its index in the node list.
+    Interior(u32),
+    /// A leaf over `prim_refs[first..first + count]`.
+    Leaf {
+        first: u32,
+        count: u32,
+    },
+}
+
+impl GpuWideNode {
+    /// The origin `p` and the per-axis scale `s`.
+    pub fn frame(&self) -> (Vec3, Vec3) {
+        let p = Vec3::new(f32::from_bits(self.head[0]), f32::from_bits(self.head[1]), f32::from_bits(self.head[2]));
+        let e = |k: u32| f32::from_bits(((self.head[3] >> (8 * k)) & 0xff) << 23);
+        (p, Vec3::new(e(0), e(1), e(2)))
+    }
+
+    fn byte(words: &[u32], i: usize) -> u32 {
+        (words[i / 4] >> (8 * (i % 4))) & 0xff
+    }
+
+    /// The quantised box of slot `i`, decoded in f32 as the shader does.
+    pub fn child_box(&self, i: usize) -> Aabb {
+        let (p, s) = self.frame();
+        let b = |words: &[u32], j: usize| Self::byte(words, j) as f32;
+        let lo = Vec3::new(b(&self.q_lo_xy, i), b(&self.q_lo_xy, 8 + i), b(&self.q_lo_z_hi_x, i));
+        let hi = Vec3::new(b(&self.q_lo_z_hi_x, 8 + i), b(&self.q_hi_yz, i), b(&self.q_hi_yz, 8 + i));
+        Aabb { min: p + s * lo, max: p + s * hi }
+    }
+
+    /// Slot `i`'s meta byte.
+    pub fn meta(&self, i: usize) -> u32 {
+        Self::byte(&self.links[2..], i)
+    }
+
+    /// What slot `i` holds.
+    pub fn child(&self, i: usize) -> WideChild {
+        let m = self.meta(i);
+        let imask = self.head[3] >> 24;
+        if m == 0 {
+            WideChild::Empty
+        } else if m >> 5 == 0 {
+            WideChild::Interior(self.links[0] + (imask & ((1 << i) - 1)).count_ones())
+        } else {
+            WideChild::Leaf { first: self.links[1] + (m & 31), count: m >> 5 }
+        }
+    }
+}
+
+/// A BVH2 child: what the collapse moves between nodes.
+#[derive(Clone, Copy)]
+enum Child {
+    Leaf { first: u32, count: u32, bx: Aabb },
+    Interior { node: u32, bx: Aabb },
+}
+
+impl Child {
+    fn bx(&self) -> Aabb {
+        match *self {
+            Child::Leaf { bx, .. } | Child::Interior { bx, .. } => bx,
+        }
+    }
+}
+
+fn children_of(n: &GpuBvhNode) -> Vec<Child> {
+    let mut v = Vec::with_capacity(2);
+    for (lo, hi, first, count) in [(n.lmin, n.lmax, n.l_first, n.l_count), (n.rmin, n.rmax, n.r_first, n.r_count)] {
+        let bx = Aabb { min: lo.into(), max: hi.into() };
+        if count > 0 {
+            v.push(Child::Leaf { first, count, bx });
+        } else if first != EMPTY_CHILD {
+            v.push(Child::Interior { node: first, bx });
+        }
+    }
+    v
+}
+
+/// Up to eight children for one wide node: starting from a BVH2 node's two, the interior child with the largest
+/// surface area is replaced by its own children while there is room (SAH-greedy, as in the paper's simpler variant)
+/// and the leaves' primitives still fit the 24 hit bits.
+fn collapse(bvh2: &[GpuBvhNode], root: &GpuBvhNode) -> Vec<Child> {
+    let mut kids = children_of(root);
+    let prims = |k: &[Child]| k.iter().map(|c| if let Child::Leaf { count, .. } = c { *count } else { 0 }).sum::<u32>();
+    while kids.len() < WIDTH {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, c) in kids.iter().enumerate() {
+            if let Child::Interior { node, bx } = c {
+                let grand = children_of(&bvh2[*node as usize]);
+                let extra = prims(&grand);
+                if kids.len() - 1 + grand.len() <= WIDTH
+                    && prims(&kids) + extra <= MAX_NODE_PRIMS
+                    && best.is_none_or(|(_, a)| bx.half_area() > a)
+                {
+                    best = Some((i, bx.half_area()));
+                }
+            }
+        }
+        let Some((i, _)) = best else { break };
+        let Child::Interior { node, .. } = kids.swap_remove(i) else { unreachable!() };
+        kids.extend(children_of(&bvh2[node as usize]));
+    }
+    kids
+}
+
+/// Slot of each child: bit k set = the child lies on the + side of axis k (by centroid, against the parent's).
+/// Greedy on the score Σₖ ±(cₖ − pₖ): the best-matching (child, slot) pair first.
+fn assign_slots(kids: &[Child]) -> [Option<usize>; WIDTH] {
+    let centre = |b: &Aabb| (b.min.as_dvec3() + b.max.as_dvec3()) * 0.5;
+    let parent = kids.iter().fold(Aabb::EMPTY, |a, c| a.union(&c.bx()));
+    let pc = centre(&parent);
+    let mut pairs = Vec::with_capacity(kids.len() * WIDTH);
+    for (c, k) in kids.iter().enumerate() {
+        let off = centre(&k.bx()) - pc;
+        for s in 0..WIDTH {
+            let sign = |axis: usize| if s >> axis & 1 == 1 { 1.0 } else { -1.0 };
+            pairs.push((sign(0) * off.x + sign(1) * off.y + sign(2) * off.z, c, s));
+        }
+    }
+    pairs.sort_by(|a, b| b.0.total_cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let mut slots = [None; WIDTH];
+    let mut placed = vec![false; kids.len()];
+    for (_, c, s) in pairs {
+        if slots[s].is_none() && !placed[c] {
+            slots[s] = Some(c);
+            placed[c] = true;
+        }
+    }
+    slots
+}
+
+/// f32 `p + s·q`, as the shader decodes a box edge.
+fn decode(p: f32, s: f32, q: u32) -> f32 {
+    p + s * q as f32
+}
+
+/// The biased exponent of the smallest power-of-two scale with `p + 255·s ≥ hi` in f32.
+fn scale_exponent(p: f32, hi: f32) -> u32 {
+    let ext = hi as f64 - p as f64;
+    let mut e = if ext > 0.0 { ((ext / 255.0).log2().ceil() as i32 + 127).clamp(1, 254) as u32 } else { 1 };
+    while e < 254 && decode(p, f32::from_bits(e << 23), 255) < hi {
+        e += 1;
+    }
+    e
+}
+
+/// Conservative 8-bit edges of `[lo, hi]` against origin `p` and scale `s`: `decode(q_lo) ≤ lo`,
+/// `decode(q_hi) ≥ hi`. Needs `p ≤ lo` and `decode(255) ≥ hi`.
+fn quantise(p: f32, s: f32, lo: f32, hi: f32) -> (u32, u32) {
+    let mut qlo = (((lo as f64 - p as f64) / s as f64).floor().max(0.0) as u32).min(255);
+    while qlo > 0 && decode(p, s, qlo) > lo {
+        qlo -= 1;
+    }
+    let mut qhi = (((hi as f64 - p as f64) / s as f64).ceil().max(0.0) as u32).min(255);
+    while qhi < 255 && decode(p, s, qhi) < hi {
+        qhi += 1;
+    }
+    (qlo, qhi)
+}
+
+/// Collapses a BVH2 into the wide layout. The result is a [`Bvh`] whose `wide` holds the nodes (root first) and
+/// whose `prim_refs` are in the wide tree's leaf order; its `nodes` is a single empty BVH2 root (the binary
+/// traversal is not compiled into pipelines that use the wide tree). `None` if the wide tree would be deeper than
+/// [`MAX_WIDE_DEPTH`] (the caller keeps the BVH2).
+pub fn widen(bvh: &Bvh) -> Option<Bvh> {
+    let start = std::time::Instant::now();
+    let mut wide: Vec<GpuWideNode> = vec![GpuWideNode::default()];
+    let mut refs: Vec<u32> = Vec::with_capacity(bvh.prim_refs.len());
+    // (BVH2 node, wide node index, depth)
+    let mut todo = vec![(0u32, 0usize, 1usize)];
+    let mut depth = 1;
+    while let Some((src, dst, d)) = todo.pop() {
+        depth = depth.max(d);
+        if depth > MAX_WIDE_DEPTH {
+            return None;
+        }
+        let kids = collapse(&bvh.nodes, &bvh.nodes[src as usize]);
+        let slots = assign_slots(&kids);
+        let parent = kids.iter().fold(Aabb::EMPTY, |a, c| a.union(&c.bx()));
+        let mut node = GpuWideNode::default();
+        let mut e = [1u32; 3];
+        if !kids.is_empty() {
+            for k in 0..3 {
+                node.head[k] = parent.min[k].to_bits();
+                e[k] = scale_exponent(parent.min[k], parent.max[k]);
+            }
+        }
+        let (p, _) = node.frame();
+        let s = Vec3::from_array(e.map(|e| f32::from_bits(e << 23)));
+        let mut imask = 0u32;
+        let child_base = wide.len() as u32;
+        let tri_base = refs.len() as u32;
+        let mut bytes = [[0u32; WIDTH]; 7]; // meta, lo x/y/z, hi x/y/z
+        for (slot, c) in slots.iter().enumerate() {
+            let Some(c) = *c else { continue };
+            let kid = kids[c];
+            let bx = kid.bx();
+            for k in 0..3 {
+                let (lo, hi) = quantise(p[k], s[k], bx.min[k], bx.max[k]);
+                bytes[1 + k][slot] = lo;
+                bytes[4 + k][slot] = hi;
+            }
+            bytes[0][slot] = match kid {
+                Child::Leaf { first, count, .. } => {
+                    let offset = refs.len() as u32 - tri_base;
+                    debug_assert!(count <= MAX_LEAF_PRIMS && offset + count <= MAX_NODE_PRIMS);
+                    refs.extend_from_slice(&bvh.prim_refs[first as usize..(first + count) as usize]);
+                    count << 5 | offset
+                }
+                Child::Interior { node: n, .. } => {
+                    imask |= 1 << slot;
+                    let idx = wide.len();
+                    wide.push(GpuWideNode::default());
+                    todo.push((n, idx, d + 1));
+                    24 + slot as u32
+                }
+            };
+        }
+        let pack = |b: &[u32; WIDTH], half: usize| (0..4).fold(0u32, |w, i| w | b[4 * half + i] << (8 * i));
+        node.head[3] = e[0] | e[1] << 8 | e[2] << 16 | imask << 24;
+        node.links = [child_base, tri_base, pack(&bytes[0], 0), pack(&bytes[0], 1)];
+        node.q_lo_xy = [pack(&bytes[1], 0), pack(&bytes[1], 1), pack(&bytes[2], 0), pack(&bytes[2], 1)];
+        node.q_lo_z_hi_x = [pack(&bytes[3], 0), pack(&bytes[3], 1), pack(&bytes[4], 0), pack(&bytes[4], 1)];
+        node.q_hi_yz = [pack(&bytes[5], 0), pack(&bytes[5], 1), pack(&bytes[6], 0), pack(&bytes[6], 1)];
+        wide[dst] = node;
+    }
+    let empty = GpuBvhNode {
+        lmin: Aabb::EMPTY.min.into(),
+        l_first: EMPTY_CHILD,
+        lmax: Aabb::EMPTY.max.into(),
+        l_count: 0,
+        rmin: Aabb::EMPTY.min.into(),
+        r_first: EMPTY_CHILD,
+        rmax: Aabb::EMPTY.max.into(),
+        r_count: 0,
+    };
+    Some(Bvh {
+        nodes: vec![empty],
+        prim_refs: refs,
+        wide,
+        build_seconds: bvh.build_seconds + start.elapsed().as_secs_f64(),
+        sah_cost: bvh.sah_cost,
+    })
+}
+
+/// Depth of a wide tree (root = 1).
+pub fn depth(wide: &[GpuWideNode]) -> usize {
+    let mut max = 0;
+    let mut stack = vec![(0u32, 1usize)];
+    while let Some((n, d)) = stack.pop() {
+        max = max.max(d);
+        for i in 0..WIDTH {
+            if let WideChild::Interior(c) = wide[n as usize].child(i) {
+                stack.push((c, d + 1));
+            }
+        }
+    }
+    max
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Decoded edges contain the input interval for awkward origins, scales and magnitudes.
+    #[test]
+    fn quantised_edges_are_conservative() {
+        let mut x = 0x9e3779b97f4a7c15u64;
+        let mut rnd = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for i in 0..20000 {
+            let mag = 10f64.powf(rnd() * 60.0 - 30.0) as f32;
+            let (a, b) = ((rnd() * 2.0 - 1.0) as f32 * mag, (rnd() * 2.0 - 1.0) as f32 * mag);
+            let (p, top) = (a.min(b), a.max(b));
+            let top = if i % 7 == 0 { p } else { top };
+            let e = scale_exponent(p, top);
+            let s = f32::from_bits(e << 23);
+            assert!(decode(p, s, 255) >= top, "scale too small for [{p}, {top}]");
+            let (c0, c1) = (p + (top - p) * rnd() as f32, p + (top - p) * rnd() as f32);
+            let (lo, hi) = (c0.min(c1).max(p), c0.max(c1).min(top));
+            let (ql, qh) = quantise(p, s, lo, hi);
+            assert!(decode(p, s, ql) <= lo && decode(p, s, qh) >= hi, "[{lo}, {hi}] in [{p}, {top}]: {ql} {qh}");
+        }
+    }
+}
