@@ -86,18 +86,32 @@ struct Quad {
     _pad0: u32,
 }
 
-/// Per-triangle shading data (positions live in `tri_verts`, three vec4 per triangle).
+/// Per-triangle shading data (positions live in `tri_verts`, three vec4 per triangle): its three shading vertices
+/// (indices into `shading_verts`) and its light (INVALID: none). Read through `scene_tri_shading` (surface.wgsl).
 struct TriShading {
-    n0: vec3<f32>,
-    material: u32,
-    n1: vec3<f32>,
+    corners: vec3<u32>,
     light: u32,
-    n2: vec3<f32>,
-    alpha_texture: u32,    // cut-out mask: 0 none, k + 1 texture k's alpha channel (alpha.wgsl)
-    uv0: vec2<f32>,
-    uv1: vec2<f32>,
-    uv2: vec2<f32>,
-    _pad1: vec2<u32>,
+}
+
+/// A shading vertex, shared between triangles (src/render/shading_data.rs): octahedral normal (oct_decode), material
+/// index (low 16 bits) and cut-out mask (high 16: 0 none, k + 1 texture k's alpha channel), uv.
+struct ShadingVertex {
+    normal: u32,
+    material: u32,
+    uv: vec2<f32>,
+}
+
+/// The code of "no usable normal" (shading_data::NO_NORMAL): decodes to zero.
+const NO_NORMAL: u32 = 0x80008000u;
+
+/// Octahedral normal (2 × snorm16, Cigolle et al. 2014): the upper half of the octahedron maps to itself, the
+/// lower half is folded over its edges; normalised. Branch-free (a select), so lanes stay together.
+fn oct_decode(code: u32) -> vec3<f32> {
+    let e = unpack2x16snorm(code);
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    let folded = (vec2<f32>(1.0) - abs(e.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), e >= vec2<f32>(0.0));
+    let n = normalize(vec3<f32>(select(e, folded, z < 0.0), z));
+    return select(n, vec3<f32>(0.0), code == NO_NORMAL);
 }
 
 /// glTF metallic-roughness material (KHR_materials_specular's specularFactor included).

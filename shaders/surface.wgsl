@@ -1,5 +1,28 @@
 // surface.wgsl — from a hit to a shading point: position, normals, uv, material with textures applied.
 
+/// A triangle's shading attributes, decoded from its `TriShading` and three `ShadingVertex` entries (CPU twin:
+/// src/render/shading_data.rs `decode`). A normal is unit, or zero where the vertex has none.
+struct TriAttributes {
+    n0: vec3<f32>,
+    n1: vec3<f32>,
+    n2: vec3<f32>,
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
+    material: u32,
+    light: u32,
+    alpha_texture: u32,    // cut-out mask: 0 none, k + 1 texture k's alpha channel (alpha.wgsl)
+}
+
+fn scene_tri_shading(i: u32) -> TriAttributes {
+    let t = scene_tri_record(i);
+    let a = scene_shading_vertex(t.corners.x);
+    let b = scene_shading_vertex(t.corners.y);
+    let c = scene_shading_vertex(t.corners.z);
+    return TriAttributes(oct_decode(a.normal), oct_decode(b.normal), oct_decode(c.normal), a.uv, b.uv, c.uv,
+        a.material & 0xffffu, t.light, a.material >> 16u);
+}
+
 /// A shading point. `ng`/`ns` are flipped to the side the ray came from; `front` says whether the ray
 /// hit the front (emitting) face; `light` is the emitter's index in the light table or INVALID.
 struct Surface {

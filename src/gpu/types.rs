@@ -62,21 +62,25 @@ pub struct GpuQuad {
     pub _pad0: u32,
 }
 
-/// Per-triangle shading data (WGSL `TriShading`).
+/// Per-triangle shading data (WGSL `TriShading`): its three shading vertices (`GpuShadingVertex`, in the
+/// `shading_verts` table) and its light. Encoding and decoding: src/render/shading_data.rs.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuTriShading {
-    pub n0: [f32; 3],
-    pub material: u32,
-    pub n1: [f32; 3],
+    pub corners: [u32; 3],
+    /// Index in the light table, or INVALID.
     pub light: u32,
-    pub n2: [f32; 3],
-    /// Cut-out mask: 0 none, k + 1 the texture k whose alpha channel is the coverage (shaders/alpha.wgsl).
-    pub alpha_texture: u32,
-    pub uv0: [f32; 2],
-    pub uv1: [f32; 2],
-    pub uv2: [f32; 2],
-    pub _pad1: [u32; 2],
+}
+
+/// A shading vertex (WGSL `ShadingVertex`), shared by the triangles whose corners have the same contents.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuShadingVertex {
+    /// Octahedral normal, 2 × snorm16 (`shading_data::oct_encode`; `NO_NORMAL` = none).
+    pub normal: u32,
+    /// Material index (low 16 bits) and cut-out mask (high 16: 0 none, k + 1 texture k's alpha channel).
+    pub material: u32,
+    pub uv: [f32; 2],
 }
 
 /// A material (WGSL `Material`); see the WGSL comment for the meaning of each field.

@@ -63,7 +63,7 @@ const fn scene(
 pub const GEOMETRY_BINDINGS: u32 = 5;
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 14] = [
+pub const SCENE: [SceneBinding; 15] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -122,6 +122,10 @@ pub const SCENE: [SceneBinding; 14] = [
     SceneBinding {
         binding: scene(13, "light_tree", "array<LightNode>", size_of::<GpuLightNode>(), "light tree"),
         bytes: |d| bytemuck::cast_slice(&d.light_tree),
+    },
+    SceneBinding {
+        binding: scene(14, "shading_verts", "array<ShadingVertex>", size_of::<GpuShadingVertex>(), "shading vertices"),
+        bytes: |d| bytemuck::cast_slice(&d.shading_verts),
     },
 ];
 

@@ -98,7 +98,7 @@ impl Features {
         // The metallic-roughness materials (other kinds have their own constants).
         let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
         let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
-        let alpha = data.tri_shading.iter().any(|t| t.alpha_texture != 0);
+        let alpha = data.has_alpha_cutouts();
         let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
             (false, _) => EnvKind::None,
             (true, false) => EnvKind::Constant,
