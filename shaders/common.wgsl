@@ -65,6 +65,7 @@ const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
 const TEX_IMAGE: u32 = 0u;
 const TEX_CHECKERBOARD: u32 = 1u;
+const TEXEL_HI: u32 = 0x80000000u;
 
 /// An analytic sphere. Emission, if any, comes from its material; `light` indexes the light table.
 struct Sphere {
@@ -299,6 +300,9 @@ override ENV_KIND: u32 = 3u;
 override HAS_TEXTURES: bool = true;
 /// Any pbrt checkerboard texture (TEX_CHECKERBOARD).
 override HAS_CHECKERBOARD: bool = true;
+/// Texels over two bindings (src/render/gpu_scene.rs split_texels): a TextureInfo offset with TEXEL_HI set
+/// counts into tex_texels_hi. False: that read is compiled out.
+override HAS_TEXEL_SPLIT: bool = true;
 /// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
 override HAS_SPECULAR: bool = true;
 /// Any MaterialKind::Conductor (bsdf_conductor.wgsl).

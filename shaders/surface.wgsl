@@ -104,10 +104,16 @@ fn wrap_coord(x: i32, n: i32, mode: u32) -> i32 {
     return m;
 }
 
+/// Word `i` of the texture at `offset` (TEXEL_HI: in the second texel binding).
+fn texel_word(offset: u32, i: u32) -> u32 {
+    if (HAS_TEXEL_SPLIT && (offset & TEXEL_HI) != 0u) { return tex_texels_hi[(offset & ~TEXEL_HI) + i]; }
+    return tex_texels[offset + i];
+}
+
 fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
     let xi = wrap_coord(x, i32(info.width), info.wrap_s);
     let yi = wrap_coord(y, i32(info.height), info.wrap_t);
-    var c = unpack4x8unorm(tex_texels[info.offset + u32(yi) * info.width + u32(xi)]);
+    var c = unpack4x8unorm(texel_word(info.offset, u32(yi) * info.width + u32(xi)));
     if (info.srgb != 0u) {
         c = vec4<f32>(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w);
     }
@@ -120,8 +126,9 @@ fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
 fn checkerboard_lookup(info: TextureInfo, st: vec2<f32>) -> vec4<f32> {
     // Clamped so the i32 conversion cannot overflow (±2^24 keeps the parity of exactly representable floors).
     let f = vec2<i32>(floor(clamp(st, vec2<f32>(-16777216.0), vec2<f32>(16777216.0))));
-    let o = info.offset + select(0u, 3u, ((f.x + f.y) & 1) != 0);
-    return vec4<f32>(bitcast<f32>(tex_texels[o]), bitcast<f32>(tex_texels[o + 1u]), bitcast<f32>(tex_texels[o + 2u]), 1.0);
+    let o = select(0u, 3u, ((f.x + f.y) & 1) != 0);
+    let w = vec3<u32>(texel_word(info.offset, o), texel_word(info.offset, o + 1u), texel_word(info.offset, o + 2u));
+    return vec4<f32>(bitcast<vec3<f32>>(w), 1.0);
 }
 
 /// Bilinear (or nearest) lookup with the texture's wrap modes, after the 2×3 uv transform; or a procedural

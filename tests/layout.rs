@@ -200,6 +200,7 @@ fn tag_constants_match() {
         ("WRAP_MIRROR", WRAP_MIRROR),
         ("TEX_IMAGE", TEX_IMAGE),
         ("TEX_CHECKERBOARD", TEX_CHECKERBOARD),
+        ("TEXEL_HI", TEXEL_HI),
         ("INVALID", INVALID),
         ("NO_NORMAL", mislab::render::shading_data::NO_NORMAL),
         ("LIGHT_LEAF_BIT", mislab::accel::light_tree::LEAF_BIT),

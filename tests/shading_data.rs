@@ -112,3 +112,34 @@ fn scenes_beyond_the_packing_are_refused_naming_the_file() {
     let err = check_packing_limits(path, &scene).expect_err("mask index too large");
     assert!(err.message.contains("cut-out mask"), "{}", err.message);
 }
+
+/// A scene whose texels exceed the binding limit the renderer believes takes them over two bindings
+/// (gpu_scene::split_texels) and renders bit for bit as with one; past two bindings it is a clear error.
+#[test]
+fn texels_split_over_two_bindings_render_as_one() {
+    use mislab::render::{features::Features, gpu_scene::GpuScene, Renderer};
+    let ctx = common::gpu();
+    let mut scene = common::scene(&format!("{TESTDATA}/TextureTransformTest/glTF/TextureTransformTest.gltf"));
+    scene.environment = mislab::scene::Environment::Constant(Vec3::ONE);
+    let data = SceneData::build(&scene);
+    let (bytes, n) = (4 * data.tex_texels.len() as u64, data.tex_info.len());
+    assert!(n >= 4, "{n} textures");
+    let render = |gs: &GpuScene| {
+        let mut r = Renderer::new(&ctx, gs, scene.camera.clone(), common::small(40, 40)).expect("renderer");
+        r.render(&ctx, 2).expect("render");
+        r.film(&ctx).expect("readback")
+    };
+    let whole = GpuScene::upload(&ctx, data.clone()).expect("upload");
+    assert!(whole.data.tex_texels_hi.is_empty() && !Features::of(&whole.data).texel_split);
+    // A limit that cuts the texture list in the middle.
+    let mid = 4 * data.tex_info[n / 2].offset as u64;
+    let split = GpuScene::upload_with_limit(&ctx, data.clone(), mid.max(bytes - mid)).expect("split upload");
+    let moved = split.data.tex_info.iter().filter(|t| t.offset & mislab::gpu::types::TEXEL_HI != 0).count();
+    assert!(moved >= 1 && moved < n && Features::of(&split.data).texel_split, "{moved} of {n} textures moved");
+    let (a, b) = (render(&whole), render(&split));
+    assert!(a.mean.iter().flatten().any(|&c| c > 0.0), "black render");
+    assert_eq!(a.mean, b.mean, "split texels render differently");
+    let err = GpuScene::upload_with_limit(&ctx, data, bytes / 4).err().expect("texels in four bindings' worth");
+    let msg = err.to_string();
+    assert!(msg.contains("texels") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
+}

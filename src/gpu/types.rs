@@ -36,6 +36,9 @@ pub const WRAP_MIRROR: u32 = 2;
 /// Texture kinds (`TextureInfo::tex_kind`): texels, or pbrt's checkerboard (two linear RGB colours as six f32 words
 /// at `offset`, no texels).
 pub const TEX_IMAGE: u32 = 0;
+/// Set in `GpuTextureInfo::offset` of a texture whose texels are in the second texel binding (`tex_texels_hi`,
+/// src/render/gpu_scene.rs `split_texels`); the rest of the offset counts from that binding's start.
+pub const TEXEL_HI: u32 = 1 << 31;
 pub const TEX_CHECKERBOARD: u32 = 1;
 
 /// An analytic sphere (WGSL `Sphere`).

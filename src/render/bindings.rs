@@ -63,7 +63,7 @@ const fn scene(
 pub const GEOMETRY_BINDINGS: u32 = 5;
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 15] = [
+pub const SCENE: [SceneBinding; 16] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -126,6 +126,13 @@ pub const SCENE: [SceneBinding; 15] = [
     SceneBinding {
         binding: scene(14, "shading_verts", "array<ShadingVertex>", size_of::<GpuShadingVertex>(), "shading vertices"),
         bytes: |d| bytemuck::cast_slice(&d.shading_verts),
+    },
+    SceneBinding {
+        binding: Binding {
+            note: "Texels of the textures whose offset has TEXEL_HI set, where the texels exceed one binding.",
+            ..scene(15, "tex_texels_hi", "array<u32>", 4, "texels beyond the first binding")
+        },
+        bytes: |d| bytemuck::cast_slice(&d.tex_texels_hi),
     },
 ];
 

@@ -35,6 +35,9 @@ pub struct SceneData {
     pub tex_info: Vec<GpuTextureInfo>,
     /// All texels, RGBA8 packed.
     pub tex_texels: Vec<u32>,
+    /// Texels moved out of `tex_texels` because they exceed one binding (`gpu_scene::split_texels`); empty
+    /// unless split.
+    pub tex_texels_hi: Vec<u32>,
     /// Environment texels (rgb + density), empty for none/constant.
     pub env_texels: Vec<[f32; 4]>,
     /// Environment alias table.
