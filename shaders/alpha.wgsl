@@ -11,10 +11,13 @@ const ALPHA_CUTOFF: f32 = 0.5;
 /// Whether the hit at barycentrics (b1, b2) of primitive `prim` lies in a cut-out. Triangles only.
 fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool {
     if (prim_kind(prim) != PRIM_TRIANGLE) { return false; }
-    let sh = scene_tri_shading(prim_index(prim));
-    if (sh.alpha_texture == 0u) { return false; }
-    let uv = (1.0 - b1 - b2) * sh.uv0 + b1 * sh.uv1 + b2 * sh.uv2;
+    // The first corner's material word says whether there is a mask; only then are the other two corners read.
+    let t = scene_tri_record(prim_index(prim));
+    let a = scene_shading_vertex(t.corners.x);
+    let mask = a.material >> 16u;
+    if (mask == 0u) { return false; }
+    let uv = (1.0 - b1 - b2) * a.uv + b1 * scene_shading_vertex(t.corners.y).uv + b2 * scene_shading_vertex(t.corners.z).uv;
     // The mask's own uv: identity (the importer warns about uv scale/offset on a mask).
-    let c = texture_lookup(sh.alpha_texture - 1u, vec4<f32>(1.0, 0.0, 0.0, 0.0), vec4<f32>(0.0, 1.0, 0.0, 0.0), uv);
+    let c = texture_lookup(mask - 1u, vec4<f32>(1.0, 0.0, 0.0, 0.0), vec4<f32>(0.0, 1.0, 0.0, 0.0), uv);
     return c.w < ALPHA_CUTOFF;
 }

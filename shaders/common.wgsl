@@ -65,6 +65,7 @@ const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
 const TEX_IMAGE: u32 = 0u;
 const TEX_CHECKERBOARD: u32 = 1u;
+const TEXEL_HI: u32 = 0x80000000u;
 
 /// An analytic sphere. Emission, if any, comes from its material; `light` indexes the light table.
 struct Sphere {
@@ -86,18 +87,32 @@ struct Quad {
     _pad0: u32,
 }
 
-/// Per-triangle shading data (positions live in `tri_verts`, three vec4 per triangle).
+/// Per-triangle shading data (positions live in `tri_verts`, three vec4 per triangle): its three shading vertices
+/// (indices into `shading_verts`) and its light (INVALID: none). Read through `scene_tri_shading` (surface.wgsl).
 struct TriShading {
-    n0: vec3<f32>,
-    material: u32,
-    n1: vec3<f32>,
+    corners: vec3<u32>,
     light: u32,
-    n2: vec3<f32>,
-    alpha_texture: u32,    // cut-out mask: 0 none, k + 1 texture k's alpha channel (alpha.wgsl)
-    uv0: vec2<f32>,
-    uv1: vec2<f32>,
-    uv2: vec2<f32>,
-    _pad1: vec2<u32>,
+}
+
+/// A shading vertex, shared between triangles (src/render/shading_data.rs): octahedral normal (oct_decode), material
+/// index (low 16 bits) and cut-out mask (high 16: 0 none, k + 1 texture k's alpha channel), uv.
+struct ShadingVertex {
+    normal: u32,
+    material: u32,
+    uv: vec2<f32>,
+}
+
+/// The code of "no usable normal" (shading_data::NO_NORMAL): decodes to zero.
+const NO_NORMAL: u32 = 0x80008000u;
+
+/// Octahedral normal (2 × snorm16, Cigolle et al. 2014): the upper half of the octahedron maps to itself, the
+/// lower half is folded over its edges; normalised. Branch-free (a select), so lanes stay together.
+fn oct_decode(code: u32) -> vec3<f32> {
+    let e = unpack2x16snorm(code);
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    let folded = (vec2<f32>(1.0) - abs(e.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), e >= vec2<f32>(0.0));
+    let n = normalize(vec3<f32>(select(e, folded, z < 0.0), z));
+    return select(n, vec3<f32>(0.0), code == NO_NORMAL);
 }
 
 /// glTF metallic-roughness material (KHR_materials_specular's specularFactor included).
@@ -285,6 +300,9 @@ override ENV_KIND: u32 = 3u;
 override HAS_TEXTURES: bool = true;
 /// Any pbrt checkerboard texture (TEX_CHECKERBOARD).
 override HAS_CHECKERBOARD: bool = true;
+/// Texels over two bindings (src/render/gpu_scene.rs split_texels): a TextureInfo offset with TEXEL_HI set
+/// counts into tex_texels_hi. False: that read is compiled out.
+override HAS_TEXEL_SPLIT: bool = true;
 /// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
 override HAS_SPECULAR: bool = true;
 /// Any MaterialKind::Conductor (bsdf_conductor.wgsl).

@@ -15,7 +15,8 @@ struct TriPositions {
 fn scene_tri_positions(i: u32) -> TriPositions {
     return TriPositions(tri_verts[3u * i].xyz, tri_verts[3u * i + 1u].xyz, tri_verts[3u * i + 2u].xyz);
 }
-fn scene_tri_shading(i: u32) -> TriShading { return tri_shading[i]; }
+fn scene_tri_record(i: u32) -> TriShading { return tri_shading[i]; }
+fn scene_shading_vertex(i: u32) -> ShadingVertex { return shading_verts[i]; }
 fn scene_sphere(i: u32) -> Sphere { return spheres[i]; }
 fn scene_quad(i: u32) -> Quad { return quads[i]; }
 fn scene_material(i: u32) -> Material { return materials[i]; }

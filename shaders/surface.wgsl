@@ -1,5 +1,28 @@
 // surface.wgsl — from a hit to a shading point: position, normals, uv, material with textures applied.
 
+/// A triangle's shading attributes, decoded from its `TriShading` and three `ShadingVertex` entries (CPU twin:
+/// src/render/shading_data.rs `decode`). A normal is unit, or zero where the vertex has none.
+struct TriAttributes {
+    n0: vec3<f32>,
+    n1: vec3<f32>,
+    n2: vec3<f32>,
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
+    material: u32,
+    light: u32,
+    alpha_texture: u32,    // cut-out mask: 0 none, k + 1 texture k's alpha channel (alpha.wgsl)
+}
+
+fn scene_tri_shading(i: u32) -> TriAttributes {
+    let t = scene_tri_record(i);
+    let a = scene_shading_vertex(t.corners.x);
+    let b = scene_shading_vertex(t.corners.y);
+    let c = scene_shading_vertex(t.corners.z);
+    return TriAttributes(oct_decode(a.normal), oct_decode(b.normal), oct_decode(c.normal), a.uv, b.uv, c.uv,
+        a.material & 0xffffu, t.light, a.material >> 16u);
+}
+
 /// A shading point. `ng`/`ns` are flipped to the side the ray came from; `front` says whether the ray
 /// hit the front (emitting) face; `light` is the emitter's index in the light table or INVALID.
 struct Surface {
@@ -81,10 +104,16 @@ fn wrap_coord(x: i32, n: i32, mode: u32) -> i32 {
     return m;
 }
 
+/// Word `i` of the texture at `offset` (TEXEL_HI: in the second texel binding).
+fn texel_word(offset: u32, i: u32) -> u32 {
+    if (HAS_TEXEL_SPLIT && (offset & TEXEL_HI) != 0u) { return tex_texels_hi[(offset & ~TEXEL_HI) + i]; }
+    return tex_texels[offset + i];
+}
+
 fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
     let xi = wrap_coord(x, i32(info.width), info.wrap_s);
     let yi = wrap_coord(y, i32(info.height), info.wrap_t);
-    var c = unpack4x8unorm(tex_texels[info.offset + u32(yi) * info.width + u32(xi)]);
+    var c = unpack4x8unorm(texel_word(info.offset, u32(yi) * info.width + u32(xi)));
     if (info.srgb != 0u) {
         c = vec4<f32>(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w);
     }
@@ -97,8 +126,9 @@ fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
 fn checkerboard_lookup(info: TextureInfo, st: vec2<f32>) -> vec4<f32> {
     // Clamped so the i32 conversion cannot overflow (±2^24 keeps the parity of exactly representable floors).
     let f = vec2<i32>(floor(clamp(st, vec2<f32>(-16777216.0), vec2<f32>(16777216.0))));
-    let o = info.offset + select(0u, 3u, ((f.x + f.y) & 1) != 0);
-    return vec4<f32>(bitcast<f32>(tex_texels[o]), bitcast<f32>(tex_texels[o + 1u]), bitcast<f32>(tex_texels[o + 2u]), 1.0);
+    let o = select(0u, 3u, ((f.x + f.y) & 1) != 0);
+    let w = vec3<u32>(texel_word(info.offset, o), texel_word(info.offset, o + 1u), texel_word(info.offset, o + 2u));
+    return vec4<f32>(bitcast<vec3<f32>>(w), 1.0);
 }
 
 /// Bilinear (or nearest) lookup with the texture's wrap modes, after the 2×3 uv transform; or a procedural

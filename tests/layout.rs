@@ -42,7 +42,8 @@ fn shared_structs_match() {
     let m = module();
     check!(m, "Sphere", GpuSphere, [center, radius, material, light, _pad0, _pad1]);
     check!(m, "Quad", GpuQuad, [corner, material, edge_u, light, edge_v, _pad0]);
-    check!(m, "TriShading", GpuTriShading, [n0, material, n1, light, n2, alpha_texture, uv0, uv1, uv2, _pad1]);
+    check!(m, "TriShading", GpuTriShading, [corners, light]);
+    check!(m, "ShadingVertex", GpuShadingVertex, [normal, material, uv]);
     check!(
         m,
         "Material",
@@ -201,7 +202,9 @@ fn tag_constants_match() {
         ("WRAP_MIRROR", WRAP_MIRROR),
         ("TEX_IMAGE", TEX_IMAGE),
         ("TEX_CHECKERBOARD", TEX_CHECKERBOARD),
+        ("TEXEL_HI", TEXEL_HI),
         ("INVALID", INVALID),
+        ("NO_NORMAL", mislab::render::shading_data::NO_NORMAL),
         ("LIGHT_LEAF_BIT", mislab::accel::light_tree::LEAF_BIT),
         // The light tree's empty child is the shader's INVALID.
         ("INVALID", mislab::accel::light_tree::EMPTY),

@@ -36,6 +36,9 @@ pub const WRAP_MIRROR: u32 = 2;
 /// Texture kinds (`TextureInfo::tex_kind`): texels, or pbrt's checkerboard (two linear RGB colours as six f32 words
 /// at `offset`, no texels).
 pub const TEX_IMAGE: u32 = 0;
+/// Set in `GpuTextureInfo::offset` of a texture whose texels are in the second texel binding (`tex_texels_hi`,
+/// src/render/gpu_scene.rs `split_texels`); the rest of the offset counts from that binding's start.
+pub const TEXEL_HI: u32 = 1 << 31;
 pub const TEX_CHECKERBOARD: u32 = 1;
 
 /// An analytic sphere (WGSL `Sphere`).
@@ -62,21 +65,25 @@ pub struct GpuQuad {
     pub _pad0: u32,
 }
 
-/// Per-triangle shading data (WGSL `TriShading`).
+/// Per-triangle shading data (WGSL `TriShading`): its three shading vertices (`GpuShadingVertex`, in the
+/// `shading_verts` table) and its light. Encoding and decoding: src/render/shading_data.rs.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuTriShading {
-    pub n0: [f32; 3],
-    pub material: u32,
-    pub n1: [f32; 3],
+    pub corners: [u32; 3],
+    /// Index in the light table, or INVALID.
     pub light: u32,
-    pub n2: [f32; 3],
-    /// Cut-out mask: 0 none, k + 1 the texture k whose alpha channel is the coverage (shaders/alpha.wgsl).
-    pub alpha_texture: u32,
-    pub uv0: [f32; 2],
-    pub uv1: [f32; 2],
-    pub uv2: [f32; 2],
-    pub _pad1: [u32; 2],
+}
+
+/// A shading vertex (WGSL `ShadingVertex`), shared by the triangles whose corners have the same contents.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuShadingVertex {
+    /// Octahedral normal, 2 × snorm16 (`shading_data::oct_encode`; `NO_NORMAL` = none).
+    pub normal: u32,
+    /// Material index (low 16 bits) and cut-out mask (high 16: 0 none, k + 1 texture k's alpha channel).
+    pub material: u32,
+    pub uv: [f32; 2],
 }
 
 /// A material (WGSL `Material`); see the WGSL comment for the meaning of each field.

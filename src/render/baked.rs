@@ -173,7 +173,9 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     let vec3s = vec!["vec3<f32>".to_string(); 3];
     out += &accessor("scene_tri_positions", "TriPositions", &vec3s, &positions, tri_read);
     let shading = wgsl_members("TriShading");
-    out += &accessor("scene_tri_shading", "TriShading", &shading, &data.tri_shading, "tri_shading[i]");
+    out += &accessor("scene_tri_record", "TriShading", &shading, &data.tri_shading, "tri_shading[i]");
+    let vertex = wgsl_members("ShadingVertex");
+    out += &accessor("scene_shading_vertex", "ShadingVertex", &vertex, &data.shading_verts, "shading_verts[i]");
     out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "spheres[i]");
     out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "quads[i]");
     out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
@@ -311,6 +313,7 @@ mod tests {
         assert_eq!(4 * words("Sphere"), std::mem::size_of::<GpuSphere>());
         assert_eq!(4 * words("Quad"), std::mem::size_of::<GpuQuad>());
         assert_eq!(4 * words("TriShading"), std::mem::size_of::<GpuTriShading>());
+        assert_eq!(4 * words("ShadingVertex"), std::mem::size_of::<GpuShadingVertex>());
         assert_eq!(wgsl_members("Material")[3], "f32");
     }
 }

@@ -77,7 +77,7 @@ pub fn shading() -> impl Iterator<Item = &'static SceneBinding> {
 }
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 15] = [
+pub const SCENE: [SceneBinding; 17] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -143,6 +143,17 @@ pub const SCENE: [SceneBinding; 15] = [
             ..scene(14, "wide_nodes", "array<WideNode>", size_of::<GpuWideNode>(), "wide BVH nodes")
         },
         bytes: |d| bytemuck::cast_slice(&d.wide_nodes),
+    },
+    SceneBinding {
+        binding: scene(15, "shading_verts", "array<ShadingVertex>", size_of::<GpuShadingVertex>(), "shading vertices"),
+        bytes: |d| bytemuck::cast_slice(&d.shading_verts),
+    },
+    SceneBinding {
+        binding: Binding {
+            note: "Texels of the textures whose offset has TEXEL_HI set, where the texels exceed one binding.",
+            ..scene(16, "tex_texels_hi", "array<u32>", 4, "texels beyond the first binding")
+        },
+        bytes: |d| bytemuck::cast_slice(&d.tex_texels_hi),
     },
 ];
 

@@ -41,6 +41,8 @@ pub struct Features {
     pub textures: bool,
     /// Any pbrt checkerboard texture (`TEX_CHECKERBOARD`).
     pub checkerboard: bool,
+    /// Texels over two bindings (`gpu_scene::split_texels`): texel reads look at `TEXEL_HI`.
+    pub texel_split: bool,
     /// Any material with a GGX lobe.
     pub specular: bool,
     /// Any material with a diffuse lobe.
@@ -82,6 +84,7 @@ impl Features {
             env: EnvKind::Any,
             textures: true,
             checkerboard: true,
+            texel_split: true,
             specular: true,
             diffuse: true,
             conductor: true,
@@ -102,7 +105,7 @@ impl Features {
         // The metallic-roughness materials (other kinds have their own constants).
         let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
         let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
-        let alpha = data.tri_shading.iter().any(|t| t.alpha_texture != 0);
+        let alpha = data.has_alpha_cutouts();
         let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
             (false, _) => EnvKind::None,
             (true, false) => EnvKind::Constant,
@@ -119,6 +122,7 @@ impl Features {
             env,
             textures: !data.tex_info.is_empty(),
             checkerboard: data.tex_info.iter().any(|t| t.tex_kind == TEX_CHECKERBOARD),
+            texel_split: data.tex_info.iter().any(|t| t.offset & TEXEL_HI != 0),
             specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
@@ -153,6 +157,7 @@ impl Features {
             ("ENV_KIND", self.env as u32 as f64),
             ("HAS_TEXTURES", b(self.textures)),
             ("HAS_CHECKERBOARD", b(self.checkerboard)),
+            ("HAS_TEXEL_SPLIT", b(self.texel_split)),
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("HAS_CONDUCTOR", b(self.conductor)),
@@ -183,6 +188,7 @@ impl Features {
         on("point/spot/directional lights", self.delta_lights);
         on("textures", self.textures);
         on("checkerboard textures", self.checkerboard);
+        on("texels over two bindings", self.texel_split);
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);

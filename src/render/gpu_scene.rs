@@ -1,6 +1,7 @@
 //! GpuScene: a scene's flattened tables (`SceneData`) uploaded as the storage buffers of the binding table,
 //! with size checks against the device's limits.
 
+use crate::gpu::types::TEXEL_HI;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
 use crate::render::scene_data::SceneData;
@@ -29,11 +30,43 @@ pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), GpuError>
     Ok(())
 }
 
+/// Texels beyond one storage binding of `limit` bytes move to the second texel binding (`tex_texels_hi`), split at
+/// a texture boundary: the first texture that does not end within the limit and every later one go there, their
+/// offsets counted from its start and marked `TEXEL_HI` (so `Features::texel_split` compiles the second read
+/// in). Texels that fit are left as they are. Past two bindings: `GpuError::TexelsTooLarge`.
+pub fn split_texels(data: &mut SceneData, limit: u64) -> Result<(), GpuError> {
+    let words = data.tex_texels.len() as u64;
+    if 4 * words <= limit || !data.tex_texels_hi.is_empty() {
+        return Ok(());
+    }
+    // Textures lie in offset order (scene_data::build_textures); each ends where the next begins.
+    let ends: Vec<u64> = data.tex_info.iter().skip(1).map(|t| t.offset as u64).chain([words]).collect();
+    let first = ends.iter().position(|&e| 4 * e > limit).unwrap_or(data.tex_info.len());
+    let cut = data.tex_info.get(first).map_or(words, |t| t.offset as u64);
+    let second = 4 * (words - cut);
+    if second > limit || words >= TEXEL_HI as u64 {
+        return Err(GpuError::TexelsTooLarge { bytes: 4 * words, second, limit });
+    }
+    data.tex_texels_hi = data.tex_texels.split_off(cut as usize);
+    for t in &mut data.tex_info[first..] {
+        t.offset = (t.offset - cut as u32) | TEXEL_HI;
+    }
+    Ok(())
+}
+
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
-    /// larger than the device's storage-buffer binding limit.
+    /// larger than the device's storage-buffer binding limit; texels may take two bindings (`split_texels`).
     pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, GpuError> {
-        check_binding_sizes(&data, ctx.max_storage_binding())?;
+        Self::upload_with_limit(ctx, data, u64::MAX)
+    }
+
+    /// `upload` as if the device's binding limit were `limit` bytes (when lower than the real one): tests take
+    /// the split path with small scenes through it.
+    pub fn upload_with_limit(ctx: &GpuContext, mut data: SceneData, limit: u64) -> Result<GpuScene, GpuError> {
+        let limit = limit.min(ctx.max_storage_binding());
+        split_texels(&mut data, limit)?;
+        check_binding_sizes(&data, limit)?;
         let buffers = bindings::SCENE
             .iter()
             .map(|b| ctx.storage_buffer_bytes(b.binding.name, (b.bytes)(&data), b.binding.element_size))

@@ -18,5 +18,6 @@ pub mod samplers;
 pub mod scene_data;
 pub mod settings;
 pub mod shaders;
+pub mod shading_data;
 
 pub use renderer::*;

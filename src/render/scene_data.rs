@@ -5,6 +5,7 @@ use crate::accel::bvh;
 use crate::accel::light_tree::{GpuLightNode, LightBounds, LightTree};
 use crate::gpu::types::*;
 use crate::render::lights::{self, luminance};
+use crate::render::shading_data::{material_word, word_material, ShadingTable};
 use crate::scene::{Environment, PunctualLight, Scene, TextureRef, Wrap};
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -14,8 +15,10 @@ use std::f64::consts::PI;
 pub struct SceneData {
     /// Three vec4 per triangle.
     pub tri_verts: Vec<[f32; 4]>,
-    /// Per-triangle shading data.
+    /// Per-triangle shading data: shading-vertex indices and light (src/render/shading_data.rs).
     pub tri_shading: Vec<GpuTriShading>,
+    /// Distinct shading vertices (normal, material, uv), indexed by `tri_shading`.
+    pub shading_verts: Vec<GpuShadingVertex>,
     /// Spheres.
     pub spheres: Vec<GpuSphere>,
     /// Quads.
@@ -32,6 +35,9 @@ pub struct SceneData {
     pub tex_info: Vec<GpuTextureInfo>,
     /// All texels, RGBA8 packed.
     pub tex_texels: Vec<u32>,
+    /// Texels moved out of `tex_texels` because they exceed one binding (`gpu_scene::split_texels`); empty
+    /// unless split.
+    pub tex_texels_hi: Vec<u32>,
     /// Environment texels (rgb + density), empty for none/constant.
     pub env_texels: Vec<[f32; 4]>,
     /// Environment alias table.
@@ -98,29 +104,30 @@ impl SceneData {
             t.filter(|&t| (t as usize) < scene.textures.len()).map_or(0, |t| t + 1)
         };
         let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
+        let mut shading = ShadingTable::default();
         for mesh in &scene.meshes {
+            let word = material_word(mat_index(mesh.material), alpha_of(mesh.material));
+            // Each mesh vertex's shading vertex, encoded once (INVALID: not yet).
+            let mut shared = vec![INVALID; mesh.positions.len()];
             for t in &mesh.indices {
                 let p = t.map(|i| mesh.positions[i as usize] - o);
-                let n = t.map(|i| mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO));
-                let uv = t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default());
                 tris.push(p);
                 for v in p {
                     d.tri_verts.push([v.x, v.y, v.z, 0.0]);
                 }
-                d.tri_shading.push(GpuTriShading {
-                    n0: n[0].into(),
-                    n1: n[1].into(),
-                    n2: n[2].into(),
-                    uv0: uv[0].into(),
-                    uv1: uv[1].into(),
-                    uv2: uv[2].into(),
-                    material: mat_index(mesh.material),
-                    light: INVALID,
-                    alpha_texture: alpha_of(mesh.material),
-                    ..Default::default()
+                let corners = t.map(|i| {
+                    let i = i as usize;
+                    if shared[i] == INVALID {
+                        let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
+                        shared[i] = shading.vertex(n, mesh.uvs.get(i).copied().unwrap_or_default(), word);
+                    }
+                    shared[i]
                 });
+                shading.triangle(corners);
             }
         }
+        d.tri_shading = shading.tris;
+        d.shading_verts = shading.verts;
         d.spheres = scene
             .spheres
             .iter()
@@ -184,6 +191,16 @@ impl SceneData {
             0 => format!("{} binary", self.bvh_nodes.len()),
             n => format!("{n} 8-wide"),
         }
+    }
+
+    /// Material index of triangle `i`.
+    pub fn tri_material(&self, i: usize) -> u32 {
+        word_material(self.shading_verts[self.tri_shading[i].corners[0] as usize].material)
+    }
+
+    /// Whether some triangle has a cut-out mask (shaders/alpha.wgsl).
+    pub fn has_alpha_cutouts(&self) -> bool {
+        self.shading_verts.iter().any(|v| crate::render::shading_data::word_alpha_texture(v.material) != 0)
     }
 
     /// Bytes of geometry + BVH per triangle (0 without triangles).
@@ -377,7 +394,7 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     let two_sided =
         |m: u32| if scene.materials.get(m as usize).is_some_and(|m| m.emission_two_sided) { 2u32 } else { 1 };
     for (i, t) in tris.iter().enumerate() {
-        let m = d.tri_shading[i].material;
+        let m = d.tri_material(i);
         if !emits(m) {
             continue;
         }

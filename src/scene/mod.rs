@@ -483,6 +483,33 @@ pub struct LoadOptions {
     pub max_texel_bytes: Option<u64>,
 }
 
+/// Most materials a scene may have: the renderer stores a triangle's material index in 16 bits
+/// (src/render/shading_data.rs `material_word`).
+pub const MAX_MATERIALS: usize = 1 << 16;
+/// Largest texture index a cut-out mask may have (stored as index + 1 in 16 bits, 0 meaning none).
+pub const MAX_MASK_TEXTURE: u32 = 0xfffe;
+
+/// Refuses (naming the file) a scene whose materials or masks the renderer's compact shading data cannot hold
+/// (`load` applies it to every file).
+pub fn check_packing_limits(path: &Path, scene: &Scene) -> Result<(), SceneError> {
+    if scene.materials.len() > MAX_MATERIALS {
+        let n = scene.materials.len();
+        return Err(SceneError::new(
+            path,
+            format!("has {n} materials; mislab holds at most {MAX_MATERIALS} (a 16-bit material index per vertex)"),
+        ));
+    }
+    if let Some(t) = scene.materials.iter().filter_map(|m| m.alpha_texture).find(|&t| t > MAX_MASK_TEXTURE) {
+        return Err(SceneError::new(
+            path,
+            format!(
+                "uses texture {t} as a cut-out mask; mislab holds mask texture indices up to {MAX_MASK_TEXTURE} only"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Loads a scene from a file (`.gltf`, `.glb`, `.toml`) or a built-in name (see `builtin::NAMES`).
 /// Never panics: loader panics on malformed files are caught and turned into errors naming the file.
 pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneError> {
@@ -518,7 +545,7 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         )),
     });
     match result {
-        Ok(r) => r,
+        Ok(r) => r.and_then(|s| check_packing_limits(path, &s).map(|()| s)),
         Err(what) => Err(SceneError::new(path, format!("malformed file (the loader failed: {what})"))),
     }
 }

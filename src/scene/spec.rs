@@ -60,8 +60,9 @@ impl SceneSpec {
         let options = LoadOptions {
             gltf_scene: self.gltf_scene,
             allow_outside_paths: self.allow_outside_paths,
-            // Refuse textures the device cannot hold before decoding them (the limit costs no device).
-            max_texel_bytes: crate::gpu::chosen_adapter_storage_limit(),
+            // Refuse textures the device cannot hold before decoding them (the limit costs no device): two
+            // bindings' worth (render/gpu_scene.rs split_texels).
+            max_texel_bytes: crate::gpu::chosen_adapter_storage_limit().map(|l| 2 * l),
         };
         let mut s = load(&self.scene, &options).map_err(|e| e.to_string())?;
         if let Some(env) = &self.env {

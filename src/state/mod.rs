@@ -148,6 +148,7 @@ pub fn scene_hash(data: &SceneData, camera: &Camera) -> String {
     let mut h = Fnv::default();
     h.write_pod(&data.tri_verts);
     h.write_pod(&data.tri_shading);
+    h.write_pod(&data.shading_verts);
     h.write_pod(&data.spheres);
     h.write_pod(&data.quads);
     h.write_pod(&data.materials);

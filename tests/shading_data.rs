@@ -1,0 +1,174 @@
+//! The compact shading data (src/render/shading_data.rs): the WGSL octahedral decode equals its CPU twin, a
+//! flattened scene keeps every triangle's uvs bit for bit and its normals within the encoding's bound, and scenes
+//! beyond the packing's limits are refused naming the file.
+
+mod common;
+
+use glam::{Vec2, Vec3};
+use mislab::render::scene_data::SceneData;
+use mislab::render::shading_data::{decode, oct_decode, oct_encode, NO_NORMAL};
+use mislab::testkit::probe::Probe;
+use std::collections::HashMap;
+
+const TESTDATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/gltf/khronos");
+
+fn angle(a: Vec3, b: Vec3) -> f64 {
+    let (a, b) = (a.as_dvec3().normalize(), b.as_dvec3().normalize());
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+const PROBE: &str = "
+fn probe_oct(code: u32) -> vec4<f32> { return vec4<f32>(oct_decode(code), 0.0); }
+";
+
+#[test]
+fn gpu_octahedral_decode_matches_the_cpu_twin() {
+    let ctx = common::gpu();
+    let mut codes = vec![NO_NORMAL, 0, 0x7fff_7fff, 0x8001_8001, 0x8000_0000, 0x0000_8000, 0x7fff_8001, 0x8001_7fff];
+    // Directions on and near the fold edges, the axes, and a spread over the sphere.
+    for k in 0..4096u32 {
+        let a = k as f32 * 0.618_034 * std::f32::consts::TAU;
+        let z = 1.0 - 2.0 * (k as f32 + 0.5) / 4096.0;
+        let r = (1.0 - z * z).sqrt();
+        codes.push(oct_encode(Vec3::new(r * a.cos(), r * a.sin(), z)));
+        codes.push(oct_encode(Vec3::new(a.cos(), a.sin(), if k % 2 == 0 { 1e-6 } else { -1e-6 })));
+    }
+    for n in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
+        codes.push(oct_encode(n));
+    }
+    let lib = mislab::render::shaders::compose(&["common.wgsl"], PROBE);
+    let gpu: Vec<[f32; 4]> = Probe::new(&ctx).map(&lib, "u32", "vec4<f32>", "probe_oct", &codes, None).expect("probe");
+    for (&code, g) in codes.iter().zip(&gpu) {
+        let (g, c) = (Vec3::new(g[0], g[1], g[2]), oct_decode(code));
+        if code == NO_NORMAL {
+            assert_eq!(g, Vec3::ZERO, "NO_NORMAL decodes to {g} on the GPU");
+            continue;
+        }
+        assert!((g - c).abs().max_element() < 2e-6, "code {code:#010x}: GPU {g} vs CPU {c}");
+    }
+}
+
+/// (mesh, triangle) of each flattened triangle, found by its positions' bits.
+fn original_triangles(scene: &mislab::scene::Scene, data: &SceneData) -> Vec<(usize, usize)> {
+    let key = |p: [Vec3; 3]| p.map(|v| v.to_array().map(f32::to_bits));
+    let mut by_positions = HashMap::new();
+    for (m, mesh) in scene.meshes.iter().enumerate() {
+        for (t, tri) in mesh.indices.iter().enumerate() {
+            by_positions.insert(key(tri.map(|i| mesh.positions[i as usize] - data.origin)), (m, t));
+        }
+    }
+    (0..data.tri_shading.len())
+        .map(|i| {
+            let p = [0, 1, 2].map(|k| Vec3::from_slice(&data.tri_verts[3 * i + k][..3]));
+            by_positions[&key(p)]
+        })
+        .collect()
+}
+
+#[test]
+fn flattened_scenes_keep_uvs_exactly_and_normals_within_5e5_rad() {
+    for file in ["BoxTextured/glTF/BoxTextured.gltf", "TextureTransformTest/glTF/TextureTransformTest.gltf"] {
+        let scene = common::scene(&format!("{TESTDATA}/{file}"));
+        let data = SceneData::build(&scene);
+        assert!(data.shading_verts.len() <= 3 * data.tri_shading.len(), "{file}: shading vertices are not shared");
+        let mut worst = 0.0f64;
+        for (i, (m, t)) in original_triangles(&scene, &data).into_iter().enumerate() {
+            let mesh = &scene.meshes[m];
+            let d = decode(&data.tri_shading[i], &data.shading_verts);
+            assert_eq!(d.material, mesh.material, "{file}: triangle {i} material");
+            for (k, &v) in mesh.indices[t].iter().enumerate() {
+                let uv = mesh.uvs.get(v as usize).copied().unwrap_or(Vec2::ZERO);
+                assert_eq!(d.uv[k].to_array().map(f32::to_bits), uv.to_array().map(f32::to_bits), "{file}: uv");
+                let n = mesh.normals.get(v as usize).copied().unwrap_or(Vec3::ZERO);
+                if n.length() > 0.0 {
+                    worst = worst.max(angle(d.n[k], n));
+                } else {
+                    assert_eq!(d.n[k], Vec3::ZERO);
+                }
+            }
+        }
+        assert!(worst < 5e-5, "{file}: normal error {worst:e} rad");
+    }
+}
+
+#[test]
+fn scenes_beyond_the_packing_are_refused_naming_the_file() {
+    use mislab::scene::{check_packing_limits, Material, Scene, MAX_MASK_TEXTURE, MAX_MATERIALS};
+    let path = std::path::Path::new("dir/many.gltf");
+    let mut scene = Scene { materials: vec![Material::default(); MAX_MATERIALS], ..Scene::default() };
+    assert!(check_packing_limits(path, &scene).is_ok(), "{MAX_MATERIALS} materials fit");
+    scene.materials.push(Material::default());
+    let err = check_packing_limits(path, &scene).expect_err("one material too many");
+    assert!(
+        err.path.ends_with("many.gltf") && err.message.contains("65537 materials"),
+        "{}: {}",
+        err.path,
+        err.message
+    );
+    scene.materials.truncate(2);
+    scene.materials[1].alpha_texture = Some(MAX_MASK_TEXTURE);
+    assert!(check_packing_limits(path, &scene).is_ok(), "mask {MAX_MASK_TEXTURE} fits");
+    scene.materials[1].alpha_texture = Some(MAX_MASK_TEXTURE + 1);
+    let err = check_packing_limits(path, &scene).expect_err("mask index too large");
+    assert!(err.message.contains("cut-out mask"), "{}", err.message);
+}
+
+/// Three quads side by side, each with its own 64² texture, under a white sky (small: a short compile).
+fn three_textured_quads() -> mislab::scene::Scene {
+    use mislab::scene::{Camera, Environment, Material, Quad, Scene, Texture, TextureKind, TextureRef, Wrap};
+    let mut scene = Scene {
+        camera: Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 50.0),
+        environment: Environment::Constant(Vec3::ONE),
+        ..Scene::default()
+    };
+    for k in 0..3u32 {
+        let texels = (0..64 * 64u32).map(|i| [(i * (k + 3)) as u8, (i / 64 * 4) as u8, (40 * k) as u8, 255]).collect();
+        scene.textures.push(Texture {
+            name: format!("t{k}"),
+            width: 64,
+            height: 64,
+            texels,
+            srgb: true,
+            wrap_s: Wrap::Repeat,
+            wrap_t: Wrap::Repeat,
+            nearest: false,
+            kind: TextureKind::Image,
+        });
+        let mut m = Material::lambert(&format!("m{k}"), Vec3::ONE);
+        m.base_color_texture = Some(TextureRef::identity(k));
+        scene.materials.push(m);
+        let corner = Vec3::new(k as f32 - 1.5, -0.5, 0.0);
+        scene.quads.push(Quad { corner, edge_u: Vec3::X, edge_v: Vec3::Y, material: k });
+    }
+    scene
+}
+
+/// A scene whose texels exceed the binding limit the renderer believes takes them over two bindings
+/// (gpu_scene::split_texels) and renders bit for bit as with one; past two bindings it is a clear error.
+#[test]
+fn texels_split_over_two_bindings_render_as_one() {
+    use mislab::render::{features::Features, gpu_scene::GpuScene, Renderer};
+    let ctx = common::gpu();
+    let scene = three_textured_quads();
+    let data = SceneData::build(&scene);
+    let (bytes, n) = (4 * data.tex_texels.len() as u64, data.tex_info.len());
+    assert_eq!(n, 3);
+    let render = |gs: &GpuScene| {
+        let mut r = Renderer::new(&ctx, gs, scene.camera.clone(), common::small(40, 40)).expect("renderer");
+        r.render(&ctx, 2).expect("render");
+        r.film(&ctx).expect("readback")
+    };
+    let whole = GpuScene::upload(&ctx, data.clone()).expect("upload");
+    assert!(whole.data.tex_texels_hi.is_empty() && !Features::of(&whole.data).texel_split);
+    // A limit that cuts the texture list in the middle.
+    let mid = 4 * data.tex_info[n / 2].offset as u64;
+    let split = GpuScene::upload_with_limit(&ctx, data.clone(), mid.max(bytes - mid)).expect("split upload");
+    let moved = split.data.tex_info.iter().filter(|t| t.offset & mislab::gpu::types::TEXEL_HI != 0).count();
+    assert!(moved >= 1 && moved < n && Features::of(&split.data).texel_split, "{moved} of {n} textures moved");
+    let (a, b) = (render(&whole), render(&split));
+    assert!(a.mean.iter().flatten().any(|&c| c > 0.0), "black render");
+    assert_eq!(a.mean, b.mean, "split texels render differently");
+    let err = GpuScene::upload_with_limit(&ctx, data, bytes / 4).err().expect("texels in four bindings' worth");
+    let msg = err.to_string();
+    assert!(msg.contains("texels") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
+}
