@@ -1,5 +1,6 @@
 //! BVH over triangles, spheres and quads: built on the CPU with obvhs (PLOC + reinsertion), flattened to the
-//! two-boxes-per-node layout that `shaders/bvh.wgsl` traverses.
+//! two-boxes-per-node layout that `shaders/bvh.wgsl` traverses; [`build_wide`] collapses it further into the 8-wide
+//! compressed layout of `crate::accel::wide_bvh` (the renderer's default).
 //!
 //! Layout ([`GpuBvhNode`], WGSL `BvhNode`): every node stores the boxes of *both* children, so a traversal step
 //! tests two boxes from one 64-byte load and never fetches a child just to reject it. For each child:
@@ -73,7 +74,7 @@ impl Bvh {
         self.nodes.len()
     }
 
-    /// Bytes of `nodes` + `prim_refs` per triangle in the tree (0 if it holds no triangles).
+    /// Bytes of `nodes` + `prim_refs` + `wide` per triangle in the tree (0 if it holds no triangles).
     pub fn bytes_per_triangle(&self) -> f64 {
         let tris = self.prim_refs.iter().filter(|&&r| r >> PRIM_KIND_SHIFT == PRIM_TRIANGLE).count();
         if tris == 0 {
