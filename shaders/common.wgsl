@@ -45,6 +45,7 @@ const LIGHT_SELECT_UNIFORM: u32 = 0u;
 const LIGHT_SELECT_POWER: u32 = 1u;
 const LIGHT_SELECT_TREE: u32 = 2u;
 const LIGHT_SELECT_RIS: u32 = 3u;
+const LIGHT_SELECT_TREE_RIS: u32 = 4u;
 
 const HEURISTIC_BALANCE: u32 = 0u;
 const HEURISTIC_POWER: u32 = 1u;

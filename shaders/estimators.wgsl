@@ -134,10 +134,13 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     if (params.num_lights == 0u) { return out; }
     // A delta-only BSDF is zero in every direction a light sample can take: no shadow ray.
     if (bsdf_is_delta(c.brdf)) { return out; }
-    if (cfg_light_select() == LIGHT_SELECT_RIS) { return ris_light_technique(c, j); }
+    if (cfg_light_select() == LIGHT_SELECT_RIS || cfg_light_select() == LIGHT_SELECT_TREE_RIS) {
+        return ris_light_technique(c, j);
+    }
     let base = dim_base(c.bounce, j);
-    let li = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT), c.x.p, c.x.ns);
-    let pmf = light_pmf(li, c.x.p, c.x.ns);
+    let pick = select_light(sample_1d(c.id, base + DIM_LIGHT_SELECT), c.x.p, c.x.ns);
+    let li = pick.index;
+    let pmf = pick.pmf;
     let u = vec3<f32>(sample_2d(c.id, base + DIM_LIGHT_UV), sample_1d(c.id, base + DIM_LIGHT_EXTRA));
     let ls = light_sample_li(li, c.x.p, u);
     out.m = ls.m;
@@ -164,13 +167,13 @@ struct RisCandidate {
     p_hat: f32,
 }
 
-/// A candidate drawn with u = (selection, uv, extra): a light by power, a point on it; p̂ = 0 where it cannot
+/// A candidate drawn with u = (selection, uv, extra): a light by power (tree-ris: by the tree), a point on it; p̂ = 0 where it cannot
 /// contribute (below either hemisphere, no sample).
 fn ris_candidate(c: ShadingCtx, u: vec4<f32>) -> RisCandidate {
     var r = RisCandidate(no_light_sample(), vec3<f32>(0.0), 0.0);
-    let li = select_light(u.x, c.x.p, c.x.ns);
-    r.ls = light_sample_li(li, c.x.p, u.yzw);
-    r.ls.pdf *= light_pmf(li, c.x.p, c.x.ns);
+    let pick = select_light(u.x, c.x.p, c.x.ns);
+    r.ls = light_sample_li(pick.index, c.x.p, u.yzw);
+    r.ls.pdf *= pick.pmf;
     let cos_s = dot(r.ls.wi, c.x.ns);
     let wi = to_local(c.frame, r.ls.wi);
     if (!(r.ls.pdf > 0.0) || cos_s == 0.0 || (cos_s < 0.0 && !bsdf_transmits(c.brdf)) || wrong_side(c, r.ls.wi, wi)) {
@@ -182,7 +185,7 @@ fn ris_candidate(c: ShadingCtx, u: vec4<f32>) -> RisCandidate {
 }
 
 /// Block 1 by resampled importance sampling (Talbot et al. 2005): M = --ris-candidates candidates from the source
-/// density p_src = pmf_power · pdf_li, one kept with probability ∝ w = p̂/p_src (a one-slot reservoir), then one
+/// density p_src = pmf · pdf_li (pmf by power for `ris`, by the light tree for `tree-ris`), one kept with probability ∝ w = p̂/p_src (a one-slot reservoir), then one
 /// shadow ray. The kept y counts f·L·cos · W with W = (Σw / M) / p̂(y), whose expectation given y is 1/p(y) of the
 /// resampled density, so the estimate is unbiased wherever p̂ > 0 where f·L·cos ≠ 0 (luminance of positive rgb).
 /// MIS: RIS's own density has no closed form, so both techniques weigh with p_src standing in for it. Any weights

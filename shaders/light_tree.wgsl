@@ -88,29 +88,34 @@ fn tree_split() -> TreeSplit {
     return TreeSplit(select(0.0, 1.0 / f32(choices), bounded > 0u), bounded, infinite);
 }
 
-fn tree_select_light(u_in: f32, p: vec3<f32>, n: vec3<f32>) -> u32 {
+/// A light drawn by the tree and its pmf, multiplied up on the way down: the same factors in the same order as
+/// tree_light_pmf, so equal to it bit for bit, without a second walk.
+fn tree_select_light(u_in: f32, p: vec3<f32>, n: vec3<f32>) -> LightPick {
     let t = tree_split();
     var u = u_in;
     if (u >= t.p_tree) {
         // One of the infinite lights, uniformly.
         let k = min(u32((u - t.p_tree) / (1.0 - t.p_tree) * f32(t.infinite)), t.infinite - 1u);
-        return t.bounded + k;
+        return LightPick(t.bounded + k, (1.0 - t.p_tree) / f32(t.infinite));
     }
     u = min(u / t.p_tree, ONE_MINUS_EPSILON);
+    var pmf = t.p_tree;
     var next = 0u;
     for (var depth = 0u; depth < 32u; depth += 1u) {
         let node = light_tree[next];
         let p0 = tree_first_child_probability(node, p, n);
         if (u < p0) {
             u = min(u / p0, ONE_MINUS_EPSILON);
+            pmf *= p0;
             next = node.next0;
         } else {
             u = min((u - p0) / (1.0 - p0), ONE_MINUS_EPSILON);
+            pmf *= 1.0 - p0;
             next = node.next1;
         }
         if ((next & LIGHT_LEAF_BIT) != 0u) { break; }
     }
-    return next & ~LIGHT_LEAF_BIT;
+    return LightPick(next & ~LIGHT_LEAF_BIT, pmf);
 }
 
 fn tree_light_pmf(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {

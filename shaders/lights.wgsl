@@ -59,11 +59,17 @@ fn no_light_sample_in(m: LightMeasure) -> LightSample {
 
 // ---- light selection ----
 
+/// Whether lights are chosen by the light tree: `tree`, and `tree-ris`'s candidates.
+fn light_select_by_tree() -> bool {
+    return cfg_light_select() == LIGHT_SELECT_TREE || cfg_light_select() == LIGHT_SELECT_TREE_RIS;
+}
+
 /// Probability of choosing light `i` from the shading point p with normal n (zero: none) under the active scheme.
 fn light_pmf(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    if (MANY_LIGHTS && cfg_light_select() == LIGHT_SELECT_TREE) { return tree_light_pmf(i, p, n); }
+    if (MANY_LIGHTS && light_select_by_tree()) { return tree_light_pmf(i, p, n); }
     let l = scene_light(i);
-    // RIS draws its candidates by power: the MIS weights of both techniques use that source density (estimators.wgsl).
+    // RIS draws its candidates by power (tree-ris: by the tree): the MIS weights of both techniques use that
+    // source density (estimators.wgsl).
     let by_power = cfg_light_select() == LIGHT_SELECT_POWER || cfg_light_select() == LIGHT_SELECT_RIS;
     return select(l.pmf_uniform, l.pmf_power, by_power);
 }
@@ -95,14 +101,22 @@ fn alias_sample2(base: u32, n: u32, u_col: f32, u_coin: f32, table_is_env: bool)
     return AliasPick(e.alias_index, min((u_coin - e.prob) / (1.0 - e.prob), ONE_MINUS_EPSILON));
 }
 
-/// Chooses one light with probability `light_pmf(·, p, n)`.
-fn select_light(u: f32, p: vec3<f32>, n: vec3<f32>) -> u32 {
-    if (!MANY_LIGHTS) { return 0u; }
+/// A chosen light and its probability, `light_pmf(index, p, n)`.
+struct LightPick {
+    index: u32,
+    pmf: f32,
+}
+
+/// Chooses one light with probability `light_pmf(·, p, n)`, and returns that probability (bit for bit: the tree
+/// multiplies it up on its way down instead of walking twice).
+fn select_light(u: f32, p: vec3<f32>, n: vec3<f32>) -> LightPick {
+    if (!MANY_LIGHTS) { return LightPick(0u, light_pmf(0u, p, n)); }
     let count = params.num_lights;
-    if (cfg_light_select() == LIGHT_SELECT_TREE) { return tree_select_light(u, p, n); }
+    if (light_select_by_tree()) { return tree_select_light(u, p, n); }
     let by_power = cfg_light_select() == LIGHT_SELECT_POWER || cfg_light_select() == LIGHT_SELECT_RIS;
-    if (by_power) { return alias_sample(0u, count, u, false); }
-    return min(u32(u * f32(count)), count - 1u);
+    var i = min(u32(u * f32(count)), count - 1u);
+    if (by_power) { i = alias_sample(0u, count, u, false); }
+    return LightPick(i, light_pmf(i, p, n));
 }
 
 // ---- area lights in common ----

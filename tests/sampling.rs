@@ -163,7 +163,7 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         }
         case R_SELECT: {
             let k = select_light(u.x, p, probe_job.a.xyz);
-            o0 = vec4<f32>(f32(k), light_pmf(k, p, probe_job.a.xyz), 0.0, 0.0);
+            o0 = vec4<f32>(f32(k.index), k.pmf, 0.0, 0.0);
         }
         case R_SPHERICAL_TRIANGLE: {
             let w = square_to_spherical_triangle(u.xy, p, probe_job.a.xyz, probe_job.b.xyz);

@@ -8,7 +8,7 @@
 //!   near the light: the r⁻² term), cosine sampling (noisy far from it: the light's small solid angle), and MIS.
 //! - `samplers`: each sequence's 2D points and error power spectrum at low spp (`sampler_figure`).
 //! - `many-lights`: the Veach scene with its lights as 80,640 triangles (`veach-mis-triangles`) under MIS with
-//!   uniform, power, light-tree and RIS light selection, at equal time (`--time` per panel, default 4 s): which
+//!   uniform, power, light-tree, RIS and tree-candidate RIS light selection, at equal time (`--time` per panel, default 4 s): which
 //!   light a sample picks decides the noise.
 
 use crate::gpu::GpuContext;
@@ -94,12 +94,13 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
         )),
         "many-lights" => Ok((
             "veach-mis-triangles",
-            2,
+            3,
             [
                 (LightSelect::Uniform, "uniform"),
                 (LightSelect::Power, "power"),
                 (LightSelect::Tree, "light tree"),
                 (LightSelect::Ris, "RIS"),
+                (LightSelect::TreeRis, "tree + RIS"),
             ]
             .into_iter()
             .map(|(light_select, label)| Panel { label, settings: Settings { light_select, ..with(Strategy::Mis) } })

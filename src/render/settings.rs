@@ -98,6 +98,9 @@ settings_enum!(
         /// Resampled importance sampling: `--ris-candidates` light samples by power, one kept ∝ its unshadowed
         /// contribution (docs/estimators.md).
         Ris = 3 => "ris",
+        /// RIS whose `--ris-candidates` candidates the light tree draws, one kept ∝ its unshadowed contribution
+        /// (docs/estimators.md).
+        TreeRis = 4 => "tree-ris",
     }
 );
 

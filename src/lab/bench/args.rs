@@ -49,6 +49,9 @@ pub struct BenchArgs {
     /// Russian-roulette start depths to compare (comma list; default 3, as `render --rr-depth`).
     #[arg(long, value_delimiter = ',')]
     pub rr_depths: Vec<u32>,
+    /// RIS candidate counts M to compare (comma list, 1..=64; default 8, as `render --ris-candidates`).
+    #[arg(long = "ris-candidates", value_delimiter = ',')]
+    pub ris_candidates: Vec<u32>,
     /// direct or path.
     #[arg(long, value_enum, default_value_t = Mode::Direct)]
     pub mode: Mode,
@@ -154,6 +157,7 @@ impl BenchArgs {
                 light_selects: self.light_selects.clone(),
                 mis: self.mis_kinds.clone(),
                 rr_depths: self.rr_depths.clone(),
+                ris_candidates: self.ris_candidates.clone(),
             }],
         };
         if self.suite.is_some() {

@@ -63,6 +63,8 @@ pub struct BenchGroup {
     pub mis: Vec<MisKind>,
     /// Russian-roulette start depths.
     pub rr_depths: Vec<u32>,
+    /// RIS candidate counts M (`ris`, `tree-ris`).
+    pub ris_candidates: Vec<u32>,
 }
 
 impl Default for BenchGroup {
@@ -94,6 +96,7 @@ impl Default for BenchGroup {
             light_selects: vec![],
             mis: vec![],
             rr_depths: vec![],
+            ris_candidates: vec![],
         }
     }
 }
@@ -127,7 +130,9 @@ impl BenchGroup {
                     for &light_sampling in &or(&self.light_samplings, d.light_sampling) {
                         for &env_sampling in &or(&self.env_samplings, d.env_sampling) {
                             for &light_select in &or(&self.light_selects, d.light_select) {
-                                for (mis, rr_depth) in pairs(&or(&self.mis, d.mis), &or(&self.rr_depths, d.rr_depth)) {
+                                let ms = or(&self.ris_candidates, d.ris_candidates);
+                                let mis_rr = pairs(&or(&self.mis, d.mis), &or(&self.rr_depths, d.rr_depth));
+                                for ((mis, rr_depth), ris_candidates) in pairs(&mis_rr, &ms) {
                                     out.push(Settings {
                                         width: self.width,
                                         height: self.height,
@@ -141,6 +146,7 @@ impl BenchGroup {
                                         light_select,
                                         mis,
                                         rr_depth,
+                                        ris_candidates,
                                         ..d.clone()
                                     });
                                 }
@@ -178,6 +184,10 @@ impl BenchGroup {
         if self.rr_depths.len() > 1 {
             parts.push(&rr);
         }
+        let m = format!("M{}", s.ris_candidates);
+        if self.ris_candidates.len() > 1 {
+            parts.push(&m);
+        }
         if self.samplers.len() > 1 {
             parts.push(s.sampler.name());
         }
@@ -210,6 +220,10 @@ impl BenchGroup {
             if !(t.is_finite() && t > 0.0) {
                 return Err(format!("group '{}': time {t} must be a positive number of seconds", self.name));
             }
+        }
+        for &ris_candidates in &self.ris_candidates {
+            let s = Settings { ris_candidates, ..Settings::default() };
+            s.validate().map_err(|e| format!("group '{}': {e}", self.name))?;
         }
         Settings { width: self.width, height: self.height, max_depth: self.max_depth, ..Settings::default() }.validate()
     }

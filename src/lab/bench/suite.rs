@@ -46,7 +46,9 @@ pub fn lecture_suite(
             ..base.clone()
         },
         BenchGroup {
-            name: "Many lights: uniform vs power vs tree vs RIS (veach-mis-triangles: 80,640 emitters, MIS)".into(),
+            name:
+                "Many lights: uniform vs power vs tree vs RIS vs tree-RIS (veach-mis-triangles: 80,640 emitters, MIS)"
+                    .into(),
             scene: "veach-mis-triangles".into(),
             strategies: vec![Strategy::Mis],
             light_selects: LightSelect::ALL.to_vec(),
@@ -54,7 +56,7 @@ pub fn lecture_suite(
             ..base.clone()
         },
         BenchGroup {
-            name: "Many lights: uniform vs power vs tree vs RIS (many-lights: 4,096 emitters, MIS)".into(),
+            name: "Many lights: uniform vs power vs tree vs RIS vs tree-RIS (many-lights: 4,096 emitters, MIS)".into(),
             scene: "many-lights".into(),
             strategies: vec![Strategy::Mis],
             light_selects: LightSelect::ALL.to_vec(),
