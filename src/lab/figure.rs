@@ -99,11 +99,15 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
                 (LightSelect::Uniform, "uniform"),
                 (LightSelect::Power, "power"),
                 (LightSelect::Tree, "light tree"),
-                (LightSelect::Ris, "RIS"),
-                (LightSelect::TreeRis, "tree + RIS"),
+                (LightSelect::Ris, "RIS, M=2"),
+                (LightSelect::TreeRis, "tree + RIS, M=2"),
             ]
             .into_iter()
-            .map(|(light_select, label)| Panel { label, settings: Settings { light_select, ..with(Strategy::Mis) } })
+            // tree-ris with M = 2: each candidate costs a walk down the 80,640-light tree (docs/estimators.md).
+            .map(|(light_select, label)| Panel {
+                label,
+                settings: Settings { light_select, ris_candidates: 2, ..with(Strategy::Mis) },
+            })
             .collect(),
         )),
         "samplers" => Err("figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into()),
