@@ -12,11 +12,13 @@ const ALPHA_CUTOFF: f32 = 0.5;
 fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool {
     if (prim_kind(prim) != PRIM_TRIANGLE) { return false; }
     // The first corner's material word says whether there is a mask; only then are the other two corners read.
-    let t = scene_tri_record(prim_index(prim));
-    let a = scene_shading_vertex(t.corners.x);
+    let i = prim_index(prim);
+    let a = scene_shading_vertex(scene_tri_corner(i, 0u));
     let mask = a.material >> 16u;
     if (mask == 0u) { return false; }
-    let uv = (1.0 - b1 - b2) * a.uv + b1 * scene_shading_vertex(t.corners.y).uv + b2 * scene_shading_vertex(t.corners.z).uv;
+    let v1 = scene_shading_vertex(scene_tri_corner(i, 1u));
+    let v2 = scene_shading_vertex(scene_tri_corner(i, 2u));
+    let uv = (1.0 - b1 - b2) * a.uv + b1 * v1.uv + b2 * v2.uv;
     // The mask's own uv: identity (the importer warns about uv scale/offset on a mask).
     let c = texture_lookup(mask - 1u, vec4<f32>(1.0, 0.0, 0.0, 0.0), vec4<f32>(0.0, 1.0, 0.0, 0.0), uv);
     return c.w < ALPHA_CUTOFF;

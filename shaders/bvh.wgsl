@@ -190,9 +190,9 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
     switch prim_kind(prim) {
         case PRIM_TRIANGLE: {
             if (!HAS_TRIANGLES) { return vec4<f32>(0.0); }
-            let v0 = tri_verts[3u * i].xyz;
-            let v1 = tri_verts[3u * i + 1u].xyz;
-            let v2 = tri_verts[3u * i + 2u].xyz;
+            let v0 = tri_position(3u * i);
+            let v1 = tri_position(3u * i + 1u);
+            let v2 = tri_position(3u * i + 2u);
             return intersect_triangle(r, v0, v1, v2, t_max);
         }
         case PRIM_SPHERE: {
@@ -208,6 +208,13 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
             return vec4<f32>(0.0);
         }
     }
+}
+
+/// Vertex k of `tri_verts` (three per triangle). The buffer is read as u32 words: w holds a shading-vertex index
+/// (src/render/scene_data.rs `pack_triangle_records`), whose bits as an f32 are a denormal, and lavapipe runs
+/// shaders with denormals flushed to zero, so it must never pass through a float register.
+fn tri_position(k: u32) -> vec3<f32> {
+    return bitcast<vec3<f32>>(tri_verts[k].xyz);
 }
 
 /// A child reference in one word, as the traversal stack and the leaf queue hold it: an interior node's index
@@ -264,7 +271,7 @@ fn bvh_leaf_test(r: TraceRay, j: u32, t: f32, skip: u32) -> LeafHit {
     if HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS {
         prim = j; // PRIM_TRIANGLE << 30 | index
         if prim != skip {
-            h = intersect_triangle(r, tri_verts[3u * prim].xyz, tri_verts[3u * prim + 1u].xyz, tri_verts[3u * prim + 2u].xyz, t);
+            h = intersect_triangle(r, tri_position(3u * prim), tri_position(3u * prim + 1u), tri_position(3u * prim + 2u), t);
         }
     } else {
         prim = prim_refs[j];

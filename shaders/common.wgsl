@@ -88,8 +88,8 @@ struct Quad {
     _pad0: u32,
 }
 
-/// Per-triangle shading data (positions live in `tri_verts`, three vec4 per triangle): its three shading vertices
-/// (indices into `shading_verts`) and its light (INVALID: none). Read through `scene_tri_shading` (surface.wgsl).
+/// Per-triangle shading data: its three shading vertices (indices into `shading_verts`, stored in the w of its three
+/// `tri_verts`) and its light (INVALID: none; stored in `tri_lights`). Read through `scene_tri_record`.
 struct TriShading {
     corners: vec3<u32>,
     light: u32,

@@ -5,17 +5,29 @@
 // bounce loop one read costs about as much as a hundred arithmetic operations; a literal costs nothing and a
 // short select chain little.
 
-/// A triangle's three positions.
+/// A triangle's three positions and its corners' shading-vertex indices (the w of each vertex: one set of loads
+/// gives both; `tri_verts` is read as u32 words, see bvh.wgsl `tri_position`).
 struct TriPositions {
     v0: vec3<f32>,
     v1: vec3<f32>,
     v2: vec3<f32>,
+    corners: vec3<u32>,
 }
 
 fn scene_tri_positions(i: u32) -> TriPositions {
-    return TriPositions(tri_verts[3u * i].xyz, tri_verts[3u * i + 1u].xyz, tri_verts[3u * i + 2u].xyz);
+    let a = tri_verts[3u * i];
+    let b = tri_verts[3u * i + 1u];
+    let c = tri_verts[3u * i + 2u];
+    return TriPositions(bitcast<vec3<f32>>(a.xyz), bitcast<vec3<f32>>(b.xyz), bitcast<vec3<f32>>(c.xyz), vec3<u32>(a.w, b.w, c.w));
 }
-fn scene_tri_record(i: u32) -> TriShading { return tri_shading[i]; }
+/// Corner k's shading-vertex index alone (one load).
+fn scene_tri_corner(i: u32, k: u32) -> u32 { return tri_verts[3u * i + k].w; }
+/// The triangle's light, or INVALID. Where no triangle emits, `tri_lights` is a few INVALID words
+/// (src/render/scene_data.rs `NO_TRI_LIGHTS`), and the clamped index reads one of them.
+fn scene_tri_light(i: u32) -> u32 {
+    return tri_lights[min(i, arrayLength(&tri_lights) - 1u)];
+}
+fn scene_tri_record(i: u32) -> TriShading { return TriShading(scene_tri_positions(i).corners, scene_tri_light(i)); }
 fn scene_shading_vertex(i: u32) -> ShadingVertex { return shading_verts[i]; }
 fn scene_sphere(i: u32) -> Sphere { return spheres[i]; }
 fn scene_quad(i: u32) -> Quad { return quads[i]; }

@@ -15,7 +15,10 @@ struct TriAttributes {
 }
 
 fn scene_tri_shading(i: u32) -> TriAttributes {
-    let t = scene_tri_record(i);
+    return tri_attributes(scene_tri_record(i));
+}
+
+fn tri_attributes(t: TriShading) -> TriAttributes {
     let a = scene_shading_vertex(t.corners.x);
     let b = scene_shading_vertex(t.corners.y);
     let c = scene_shading_vertex(t.corners.z);
@@ -51,7 +54,7 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
         // Barycentric interpolation keeps the point on the triangle's plane (o + t·d drifts off it).
         s.p = b0 * v0 + hit.b1 * v1 + hit.b2 * v2;
         ng = normalize(cross(v1 - v0, v2 - v0));
-        let sh = scene_tri_shading(i);
+        let sh = tri_attributes(TriShading(tp.corners, scene_tri_light(i)));
         ns = b0 * sh.n0 + hit.b1 * sh.n1 + hit.b2 * sh.n2;
         s.uv = b0 * sh.uv0 + hit.b1 * sh.uv1 + hit.b2 * sh.uv2;
         s.material = sh.material;

@@ -375,8 +375,9 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             data.bvh_sah,
             data.bvh_bytes()
         );
-        // Device memory per triangle: BVH (nodes + references), geometry (vertices) and shading data (per-triangle
-        // records and the shared shading vertices).
+        // Device memory per triangle: BVH (nodes and primitive references), geometry
+        // (vertices, carrying each corner's shading-vertex index) and shading data (the triangles' lights where some
+        // emit, and the shared shading vertices).
         let tris = data.tri_shading.len().max(1) as f64;
         let sizes = mislab::render::gpu_scene::binding_sizes(&data);
         let size = |name: &str| {
@@ -384,7 +385,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             table.zip(sizes).filter(|(b, _)| b.binding.name == name).map(|(_, s)| s).sum::<u64>()
         };
         let (bvh, geom) = (size("bvh_nodes") + size("prim_refs") + size("wide_nodes"), size("tri_verts"));
-        let shading = size("tri_shading") + size("shading_verts");
+        let shading = size("tri_lights") + size("shading_verts");
         println!(
             "memory per triangle: BVH {:.0} B, geometry {:.0} B, shading {:.0} B, total {:.0} B; every scene buffer {:.1} MiB",
             bvh as f64 / tris,

@@ -172,3 +172,59 @@ fn texels_split_over_two_bindings_render_as_one() {
     let msg = err.to_string();
     assert!(msg.contains("texels") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
 }
+
+const RECORD_PROBE: &str = "
+@group(2) @binding(0) var<uniform> probe_count: vec4<u32>;
+@group(2) @binding(1) var<storage, read_write> probe_out: array<vec4<u32>>;
+@group(2) @binding(2) var<storage, read> probe_in: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn probe_records(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= probe_count.x) { return; }
+    let t = scene_tri_record(i);
+    let k = i % 3u;
+    // The corners as shading reads them (with the positions), the light, and one corner alone (as alpha.wgsl does).
+    probe_out[2u * i] = vec4<u32>(scene_tri_positions(i).corners, scene_tri_light(i));
+    probe_out[2u * i + 1u] = vec4<u32>(t.corners, scene_tri_corner(i, k));
+}
+";
+
+/// Each triangle's shading-vertex indices travel in the w of its vertices and its light in `tri_lights`
+/// (`SceneData::pack_triangle_records`): the device must read back exactly the CPU's records, in a scene without
+/// emissive triangles (where `tri_lights` is a few INVALID words and a zero padding word would read as light 0) and
+/// in one with 80,640 of them.
+#[test]
+fn gpu_reads_every_triangle_record_as_the_cpu_wrote_it() {
+    use mislab::render::gpu_scene::GpuScene;
+    use mislab::testkit::scene_probe::ScenePipelines;
+    let ctx = common::gpu();
+    let files: Vec<&str> = mislab::render::RENDER_FILES.iter().copied().filter(|f| *f != "integrator.wgsl").collect();
+    let source = mislab::render::shaders::compose(&files, RECORD_PROBE);
+    let pipelines = ScenePipelines::new(&ctx, &source, &["probe_records"]).expect("probe pipelines");
+    let helmet =
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes/damagedhelmet_grey/damagedhelmet_grey.toml");
+    for (name, emitters) in [(helmet, false), ("veach-mis-triangles", true)] {
+        let data = SceneData::build(&common::scene(name));
+        let n = data.tri_shading.len();
+        assert_eq!(data.tri_shading.iter().any(|t| t.light != mislab::gpu::types::INVALID), emitters, "{name}");
+        for (i, t) in data.tri_shading.iter().enumerate() {
+            for k in 0..3 {
+                assert_eq!(data.tri_verts[3 * i + k][3].to_bits(), t.corners[k], "{name}: triangle {i} corner {k}");
+            }
+        }
+        assert_eq!(data.tri_lights.len(), if emitters { n } else { 4 }, "{name}: tri_lights");
+        let bound = pipelines.bind(&ctx, GpuScene::upload(&ctx, data.clone()).expect("upload"));
+        let frame = Default::default();
+        let job = [n as u32, 0, 0, 0];
+        let out = pipelines
+            .dispatch(&ctx, "probe_records", &bound, &frame, bytemuck::cast_slice(&job), &[], 32 * n as u64, n as u32)
+            .expect("dispatch");
+        let out: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&out);
+        for (i, t) in data.tri_shading.iter().enumerate() {
+            let c = t.corners;
+            assert_eq!(out[2 * i], [c[0], c[1], c[2], t.light], "{name}: triangle {i} (positions' corners, light)");
+            assert_eq!(out[2 * i + 1], [c[0], c[1], c[2], c[i % 3]], "{name}: triangle {i} (record, one corner)");
+        }
+    }
+}

@@ -66,7 +66,8 @@ pub struct GpuQuad {
 }
 
 /// Per-triangle shading data (WGSL `TriShading`): its three shading vertices (`GpuShadingVertex`, in the
-/// `shading_verts` table) and its light. Encoding and decoding: src/render/shading_data.rs.
+/// `shading_verts` table) and its light. Uploaded split: the indices in the w of the triangle's `tri_verts`, the light
+/// in `tri_lights` (`SceneData::pack_triangle_records`). Encoding and decoding: src/render/shading_data.rs.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuTriShading {

@@ -160,20 +160,26 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     flat_counts(data)?;
     let mut out = String::from(
         "// scene_data.wgsl, generated for one scene by src/render/baked.rs: its tables as literals.\n\n\
-         struct TriPositions {\n    v0: vec3<f32>,\n    v1: vec3<f32>,\n    v2: vec3<f32>,\n}\n\n",
+         struct TriPositions {\n    v0: vec3<f32>,\n    v1: vec3<f32>,\n    v2: vec3<f32>,\n    corners: vec3<u32>,\n}\n\n",
     );
-    let positions: Vec<[f32; 9]> = (0..data.tri_shading.len())
+    // Positions as f32 bits, then the corners' shading-vertex indices (the layout of scene_data.wgsl's struct).
+    let positions: Vec<[u32; 12]> = (0..data.tri_shading.len())
         .map(|i| {
-            let v = |k: usize| data.tri_verts[3 * i + k];
-            let (a, b, c) = (v(0), v(1), v(2));
-            [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]]
+            let v = |k: usize| data.tri_verts[3 * i + k].map(f32::to_bits);
+            let (a, b, c, s) = (v(0), v(1), v(2), data.tri_shading[i].corners);
+            [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], s[0], s[1], s[2]]
         })
         .collect();
-    let tri_read = "TriPositions(tri_verts[3u * i].xyz, tri_verts[3u * i + 1u].xyz, tri_verts[3u * i + 2u].xyz)";
-    let vec3s = vec!["vec3<f32>".to_string(); 3];
-    out += &accessor("scene_tri_positions", "TriPositions", &vec3s, &positions, tri_read);
+    let tri_read = "TriPositions(tri_position(3u * i), tri_position(3u * i + 1u), tri_position(3u * i + 2u), \
+                    vec3<u32>(tri_verts[3u * i].w, tri_verts[3u * i + 1u].w, tri_verts[3u * i + 2u].w))";
+    let members = ["vec3<f32>", "vec3<f32>", "vec3<f32>", "vec3<u32>"].map(String::from);
+    out += &accessor("scene_tri_positions", "TriPositions", &members, &positions, tri_read);
+    // Every TriShading member is a u32, so this table is always literals (no buffer fallback is ever used).
     let shading = wgsl_members("TriShading");
-    out += &accessor("scene_tri_record", "TriShading", &shading, &data.tri_shading, "tri_shading[i]");
+    out +=
+        &accessor("scene_tri_record", "TriShading", &shading, &data.tri_shading, "TriShading(vec3<u32>(0u), INVALID)");
+    out += "fn scene_tri_corner(i: u32, k: u32) -> u32 { return scene_tri_record(i).corners[k]; }\n\
+            fn scene_tri_light(i: u32) -> u32 { return scene_tri_record(i).light; }\n";
     let vertex = wgsl_members("ShadingVertex");
     out += &accessor("scene_shading_vertex", "ShadingVertex", &vertex, &data.shading_verts, "shading_verts[i]");
     out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "spheres[i]");

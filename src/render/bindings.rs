@@ -87,7 +87,7 @@ pub const SCENE: [SceneBinding; 17] = [
         bytes: |d| bytemuck::cast_slice(&d.prim_refs),
     },
     SceneBinding {
-        binding: scene(2, "tri_verts", "array<vec4<f32>>", 16, "triangle vertices"),
+        binding: scene(2, "tri_verts", "array<vec4<u32>>", 16, "triangle vertices"),
         bytes: |d| bytemuck::cast_slice(&d.tri_verts),
     },
     SceneBinding {
@@ -99,8 +99,8 @@ pub const SCENE: [SceneBinding; 17] = [
         bytes: |d| bytemuck::cast_slice(&d.quads),
     },
     SceneBinding {
-        binding: scene(5, "tri_shading", "array<TriShading>", size_of::<GpuTriShading>(), "triangle shading data"),
-        bytes: |d| bytemuck::cast_slice(&d.tri_shading),
+        binding: scene(5, "tri_lights", "array<u32>", 4, "triangle lights"),
+        bytes: |d| bytemuck::cast_slice(&d.tri_lights),
     },
     SceneBinding {
         binding: scene(6, "materials", "array<Material>", size_of::<GpuMaterial>(), "materials"),

@@ -10,13 +10,23 @@ use crate::scene::{Environment, PunctualLight, Scene, TextureRef, Wrap};
 use glam::Vec3;
 use std::f64::consts::PI;
 
+/// `tri_lights` of a scene where no triangle emits. Four words, not one: a storage buffer is at least 16 bytes
+/// (`GpuContext::storage_buffer_bytes` pads with zeros), and the shader clamps its index to the buffer's length, so
+/// every word the shader can reach must say INVALID (a zero padding word would read as light 0).
+pub const NO_TRI_LIGHTS: [u32; 4] = [INVALID; 4];
+
 /// CPU-side arrays exactly as uploaded, plus statistics. Built without a device so tests can inspect it.
 #[derive(Clone, Debug, Default)]
 pub struct SceneData {
-    /// Three vec4 per triangle.
+    /// Three vec4 per triangle: a vertex position in xyz and, in w, the bits of that corner's shading-vertex index
+    /// (`tri_shading[i].corners[k]`; `pack_triangle_records`), so triangles need no separate index record.
     pub tri_verts: Vec<[f32; 4]>,
-    /// Per-triangle shading data: shading-vertex indices and light (src/render/shading_data.rs).
+    /// Per-triangle shading data: shading-vertex indices and light (src/render/shading_data.rs). The CPU's view:
+    /// it is uploaded as the w of `tri_verts` and as `tri_lights`.
     pub tri_shading: Vec<GpuTriShading>,
+    /// Each triangle's light (index in the light table, or INVALID), or `NO_TRI_LIGHTS` when no triangle emits: 4
+    /// bytes per triangle only in scenes with emissive triangles.
+    pub tri_lights: Vec<u32>,
     /// Distinct shading vertices (normal, material, uv), indexed by `tri_shading`.
     pub shading_verts: Vec<GpuShadingVertex>,
     /// Spheres.
@@ -182,7 +192,24 @@ impl SceneData {
         d.wide_nodes = bvh.wide;
         build_textures(scene, &mut d);
         build_lights(scene, &tris, &mut d);
+        d.pack_triangle_records();
         d
+    }
+
+    /// Writes `tri_shading` into the upload form: corner k's shading-vertex index into the w of vertex k of the
+    /// triangle (a vertex is a vec4 for alignment, so this costs nothing), the lights into `tri_lights`. Shading a
+    /// hit then reads the index with the positions it already loads (shaders/scene_data.wgsl).
+    pub fn pack_triangle_records(&mut self) {
+        for (i, t) in self.tri_shading.iter().enumerate() {
+            for (k, &c) in t.corners.iter().enumerate() {
+                self.tri_verts[3 * i + k][3] = f32::from_bits(c);
+            }
+        }
+        self.tri_lights = if self.tri_shading.iter().any(|t| t.light != INVALID) {
+            self.tri_shading.iter().map(|t| t.light).collect()
+        } else {
+            NO_TRI_LIGHTS.to_vec()
+        };
     }
 
     /// Nodes of the BVH in use, and its kind ("8-wide" or "binary").
