@@ -1040,37 +1040,42 @@ fn check_wide_structure(g: &Geometry, b: &Bvh) {
     let prim_box = |p: u32| prim_box(g, p);
     let mut seen = vec![0u32; b.prim_refs.len()];
     let mut visited = vec![false; b.wide.len()];
-    // Exact box of node n's subtree, checking its children's decoded boxes on the way.
+    // Exact box and primitive count of node n's subtree, checking its children's decoded boxes on the way.
     fn subtree(
         n: usize,
         b: &Bvh,
         seen: &mut [u32],
         visited: &mut [bool],
         prim_box: &dyn Fn(u32) -> bvh::Aabb,
-    ) -> bvh::Aabb {
+    ) -> (bvh::Aabb, u32) {
         assert!(!std::mem::replace(&mut visited[n], true), "wide node {n} reached twice");
         let node = b.wide[n];
-        let (mut total, mut interior) = (bvh::Aabb::EMPTY, 0);
+        let (mut total, mut prims, mut interior) = (bvh::Aabb::EMPTY, 0, 0);
         for i in 0..WIDTH {
-            let exact = match node.child(i) {
+            let (exact, count) = match node.child(i) {
                 WideChild::Empty => continue,
                 WideChild::Interior(c) => {
                     assert_eq!(c, node.links[0] + interior, "interior children in slot order");
                     interior += 1;
-                    subtree(c as usize, b, seen, visited, prim_box)
+                    let (bx, count) = subtree(c as usize, b, seen, visited, prim_box);
+                    // The collapse turns a subtree this small into one leaf (a node step costs more).
+                    assert!(count > bvh::MAX_LEAF_PRIMS, "node {n} slot {i}: a node over only {count} primitives");
+                    (bx, count)
                 }
                 WideChild::Leaf { first, count } => {
                     assert!((1..=4).contains(&count) && first - node.links[1] + count <= MAX_NODE_PRIMS);
-                    (first..first + count).fold(bvh::Aabb::EMPTY, |a, k| {
+                    let bx = (first..first + count).fold(bvh::Aabb::EMPTY, |a, k| {
                         seen[k as usize] += 1;
                         a.union(&prim_box(b.prim_refs[k as usize]))
-                    })
+                    });
+                    (bx, count)
                 }
             };
             assert!(node.child_box(i).contains(&exact), "node {n} slot {i}: quantised box does not hold its child");
             total = total.union(&exact);
+            prims += count;
         }
-        total
+        (total, prims)
     }
     subtree(0, b, &mut seen, &mut visited, &prim_box);
     assert!(visited.iter().all(|&v| v), "unreachable wide nodes");

@@ -99,10 +99,11 @@ impl GpuWideNode {
     }
 }
 
-/// A BVH2 child: what the collapse moves between nodes.
+/// A BVH2 child: what the collapse moves between nodes. A leaf holds its primitive references themselves (up to
+/// [`MAX_LEAF_PRIMS`]): a small BVH2 subtree becomes one leaf, whose references need not be contiguous there.
 #[derive(Clone, Copy)]
 enum Child {
-    Leaf { first: u32, count: u32, bx: Aabb },
+    Leaf { refs: [u32; MAX_LEAF_PRIMS as usize], count: u32, bx: Aabb },
     Interior { node: u32, bx: Aabb },
 }
 
@@ -114,30 +115,97 @@ impl Child {
     }
 }
 
-fn children_of(n: &GpuBvhNode) -> Vec<Child> {
+/// The two children of a BVH2 node. An interior child whose whole subtree holds at most [`MAX_LEAF_PRIMS`]
+/// primitives becomes one leaf: in the 8-wide tree a node step (five vec4 loads, often for a node of only two
+/// small leaves) costs more than the one or two extra triangle tests of the merged leaf, and the tree gets smaller.
+fn children_of(tree: &Bvh2View, n: &GpuBvhNode) -> Vec<Child> {
     let mut v = Vec::with_capacity(2);
     for (lo, hi, first, count) in [(n.lmin, n.lmax, n.l_first, n.l_count), (n.rmin, n.rmax, n.r_first, n.r_count)] {
         let bx = Aabb { min: lo.into(), max: hi.into() };
         if count > 0 {
-            v.push(Child::Leaf { first, count, bx });
+            let mut refs = [0; MAX_LEAF_PRIMS as usize];
+            refs[..count as usize].copy_from_slice(&tree.prim_refs[first as usize..(first + count) as usize]);
+            v.push(Child::Leaf { refs, count, bx });
         } else if first != EMPTY_CHILD {
-            v.push(Child::Interior { node: first, bx });
+            if tree.subtree_prims[first as usize] <= MAX_LEAF_PRIMS {
+                let mut refs = [0; MAX_LEAF_PRIMS as usize];
+                let count = tree.gather(first, &mut refs, 0);
+                v.push(Child::Leaf { refs, count, bx });
+            } else {
+                v.push(Child::Interior { node: first, bx });
+            }
         }
     }
     v
 }
 
+/// The BVH2 being collapsed, with the primitive count of every node's subtree.
+struct Bvh2View<'a> {
+    nodes: &'a [GpuBvhNode],
+    prim_refs: &'a [u32],
+    subtree_prims: Vec<u32>,
+}
+
+impl<'a> Bvh2View<'a> {
+    fn new(bvh: &'a Bvh) -> Self {
+        let nodes = &bvh.nodes;
+        // Children come after their parent in the flattened BVH2 (depth-first), so a reverse sweep sees them first.
+        let mut subtree_prims = vec![0u32; nodes.len()];
+        let mut order: Vec<u32> = Vec::with_capacity(nodes.len());
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            order.push(i);
+            let n = &nodes[i as usize];
+            for (first, count) in [(n.l_first, n.l_count), (n.r_first, n.r_count)] {
+                if count == 0 && first != EMPTY_CHILD {
+                    stack.push(first);
+                }
+            }
+        }
+        for &i in order.iter().rev() {
+            let n = &nodes[i as usize];
+            let mut total = 0u32;
+            for (first, count) in [(n.l_first, n.l_count), (n.r_first, n.r_count)] {
+                total = total.saturating_add(if count > 0 {
+                    count
+                } else if first != EMPTY_CHILD {
+                    subtree_prims[first as usize]
+                } else {
+                    0
+                });
+            }
+            subtree_prims[i as usize] = total;
+        }
+        Bvh2View { nodes, prim_refs: &bvh.prim_refs, subtree_prims }
+    }
+
+    /// Appends the primitive references of node `i`'s subtree to `out` from `at`; returns the new length.
+    fn gather(&self, i: u32, out: &mut [u32], mut at: u32) -> u32 {
+        let n = &self.nodes[i as usize];
+        for (first, count) in [(n.l_first, n.l_count), (n.r_first, n.r_count)] {
+            if count > 0 {
+                out[at as usize..(at + count) as usize]
+                    .copy_from_slice(&self.prim_refs[first as usize..(first + count) as usize]);
+                at += count;
+            } else if first != EMPTY_CHILD {
+                at = self.gather(first, out, at);
+            }
+        }
+        at
+    }
+}
+
 /// Up to eight children for one wide node: starting from a BVH2 node's two, the interior child with the largest
 /// surface area is replaced by its own children while there is room (SAH-greedy, as in the paper's simpler variant)
 /// and the leaves' primitives still fit the 24 hit bits.
-fn collapse(bvh2: &[GpuBvhNode], root: &GpuBvhNode) -> Vec<Child> {
-    let mut kids = children_of(root);
+fn collapse(bvh2: &Bvh2View, root: &GpuBvhNode) -> Vec<Child> {
+    let mut kids = children_of(bvh2, root);
     let prims = |k: &[Child]| k.iter().map(|c| if let Child::Leaf { count, .. } = c { *count } else { 0 }).sum::<u32>();
     while kids.len() < WIDTH {
         let mut best: Option<(usize, f64)> = None;
         for (i, c) in kids.iter().enumerate() {
             if let Child::Interior { node, bx } = c {
-                let grand = children_of(&bvh2[*node as usize]);
+                let grand = children_of(bvh2, &bvh2.nodes[*node as usize]);
                 let extra = prims(&grand);
                 if kids.len() - 1 + grand.len() <= WIDTH
                     && prims(&kids) + extra <= MAX_NODE_PRIMS
@@ -149,7 +217,7 @@ fn collapse(bvh2: &[GpuBvhNode], root: &GpuBvhNode) -> Vec<Child> {
         }
         let Some((i, _)) = best else { break };
         let Child::Interior { node, .. } = kids.swap_remove(i) else { unreachable!() };
-        kids.extend(children_of(&bvh2[node as usize]));
+        kids.extend(children_of(bvh2, &bvh2.nodes[node as usize]));
     }
     kids
 }
@@ -218,6 +286,7 @@ pub fn widen(bvh: &Bvh) -> Option<Bvh> {
     let mut wide: Vec<GpuWideNode> = vec![GpuWideNode::default()];
     let mut refs: Vec<u32> = Vec::with_capacity(bvh.prim_refs.len());
     // (BVH2 node, wide node index, depth)
+    let view = Bvh2View::new(bvh);
     let mut todo = vec![(0u32, 0usize, 1usize)];
     let mut depth = 1;
     while let Some((src, dst, d)) = todo.pop() {
@@ -225,7 +294,7 @@ pub fn widen(bvh: &Bvh) -> Option<Bvh> {
         if depth > MAX_WIDE_DEPTH {
             return None;
         }
-        let kids = collapse(&bvh.nodes, &bvh.nodes[src as usize]);
+        let kids = collapse(&view, &bvh.nodes[src as usize]);
         let slots = assign_slots(&kids);
         let parent = kids.iter().fold(Aabb::EMPTY, |a, c| a.union(&c.bx()));
         let mut node = GpuWideNode::default();
@@ -252,10 +321,10 @@ pub fn widen(bvh: &Bvh) -> Option<Bvh> {
                 bytes[4 + k][slot] = hi;
             }
             bytes[0][slot] = match kid {
-                Child::Leaf { first, count, .. } => {
+                Child::Leaf { refs: prims, count, .. } => {
                     let offset = refs.len() as u32 - tri_base;
                     debug_assert!(count <= MAX_LEAF_PRIMS && offset + count <= MAX_NODE_PRIMS);
-                    refs.extend_from_slice(&bvh.prim_refs[first as usize..(first + count) as usize]);
+                    refs.extend_from_slice(&prims[..count as usize]);
                     count << 5 | offset
                 }
                 Child::Interior { node: n, .. } => {
