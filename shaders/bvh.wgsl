@@ -274,7 +274,11 @@ fn bvh_leaf_test(r: TraceRay, j: u32, t: f32, skip: u32) -> LeafHit {
             h = intersect_triangle(r, tri_position(3u * prim), tri_position(3u * prim + 1u), tri_position(3u * prim + 2u), t);
         }
     } else {
-        prim = prim_refs[j];
+        // A triangle-only scene uploads no references (src/render/scene_data.rs IDENTITY_PRIM_REFS): INVALID = j.
+        prim = prim_refs[min(j, arrayLength(&prim_refs) - 1u)];
+        if prim == INVALID {
+            prim = j;
+        }
         if prim != skip {
             h = intersect_prim(r, prim, t);
         }

@@ -1123,6 +1123,27 @@ fn wide_build_invariants() {
     }
 }
 
+/// A triangle-only scene uploads `IDENTITY_PRIM_REFS` instead of its references, which are then the identity
+/// (src/render/scene_data.rs): the generic traversal, which reads `prim_refs`, must find the same hits with it as
+/// with the identity uploaded.
+#[test]
+fn gpu_identity_prim_refs_read_as_the_leaf_order() {
+    let ctx = gpu();
+    let g = helmet();
+    let mut b = g.build_wide();
+    let order = bvh::into_leaf_order(&mut b, g.tris.len());
+    let g = Geometry { tris: order.iter().map(|&i| g.tris[i as usize]).collect(), spheres: vec![], quads: vec![] };
+    assert!(b.prim_refs.iter().enumerate().all(|(j, &r)| r == j as u32), "leaf order is not the identity");
+    let rays = make_rays(&g, 20_000, 5);
+    let uploaded = gpu_trace_source(&ctx, &g, &b, &rays, &wide_source());
+    b.prim_refs = mislab::render::scene_data::IDENTITY_PRIM_REFS.to_vec();
+    let sentinel = gpu_trace_source(&ctx, &g, &b, &rays, &wide_source());
+    let hits = uploaded.iter().filter(|h| h.prim != INVALID).count();
+    assert!(hits as f64 > 0.6 * rays.len() as f64, "rays should mostly hit ({hits} of {})", rays.len());
+    let same = uploaded.iter().zip(&sentinel).filter(|(a, b)| a.prim == b.prim && a.t == b.t).count();
+    assert_eq!(same, rays.len(), "hits differ with IDENTITY_PRIM_REFS");
+}
+
 /// The wide traversal's closest and any hits against the f64 reference (soup of all kinds, DamagedHelmet, single
 /// primitives, with and without the subgroup vote), and its closest hits against the BVH2 traversal's.
 #[test]

@@ -15,6 +15,12 @@ use std::f64::consts::PI;
 /// every word the shader can reach must say INVALID (a zero padding word would read as light 0).
 pub const NO_TRI_LIGHTS: [u32; 4] = [INVALID; 4];
 
+/// `prim_refs` of a scene whose leaf order is its triangle order (a triangle-only scene: `into_leaf_order` makes
+/// `prim_refs[j] == j`). The identity is not uploaded (4 bytes per triangle); the shader reads any INVALID word as
+/// "entry j is triangle j" (shaders/bvh.wgsl `bvh_leaf_test`), and the specialised triangle-only pipelines do not
+/// read `prim_refs` at all.
+pub const IDENTITY_PRIM_REFS: [u32; 4] = [INVALID; 4];
+
 /// CPU-side arrays exactly as uploaded, plus statistics. Built without a device so tests can inspect it.
 #[derive(Clone, Debug, Default)]
 pub struct SceneData {
@@ -188,7 +194,8 @@ impl SceneData {
         d.bvh_seconds = bvh.build_seconds;
         d.bvh_sah = bvh.sah_cost;
         d.bvh_nodes = bvh.nodes;
-        d.prim_refs = bvh.prim_refs;
+        let identity = bvh.prim_refs.iter().enumerate().all(|(j, &r)| r == make_prim(PRIM_TRIANGLE, j as u32));
+        d.prim_refs = if identity && !bvh.prim_refs.is_empty() { IDENTITY_PRIM_REFS.to_vec() } else { bvh.prim_refs };
         d.wide_nodes = bvh.wide;
         build_textures(scene, &mut d);
         build_lights(scene, &tris, &mut d);
