@@ -28,7 +28,16 @@ fn scene_tri_light(i: u32) -> u32 {
     return tri_lights[min(i, arrayLength(&tri_lights) - 1u)];
 }
 fn scene_tri_record(i: u32) -> TriShading { return TriShading(scene_tri_positions(i).corners, scene_tri_light(i)); }
-fn scene_shading_vertex(i: u32) -> ShadingVertex { return shading_verts[i]; }
+/// The shading vertex whose records start at `r` (a corner's w): (normal, material) and, in a scene with textures
+/// (HAS_TEXTURES), the uv's bits in the next record. Without textures no uv is stored and nothing reads one.
+fn scene_shading_vertex(r: u32) -> ShadingVertex {
+    let a = shading_verts[r];
+    var uv = vec2<f32>(0.0);
+    if HAS_TEXTURES {
+        uv = bitcast<vec2<f32>>(shading_verts[r + 1u]);
+    }
+    return ShadingVertex(a.x, a.y, uv);
+}
 fn scene_sphere(i: u32) -> Sphere { return spheres[i]; }
 fn scene_quad(i: u32) -> Quad { return quads[i]; }
 fn scene_material(i: u32) -> Material { return materials[i]; }

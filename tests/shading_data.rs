@@ -184,16 +184,19 @@ fn probe_records(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= probe_count.x) { return; }
     let t = scene_tri_record(i);
     let k = i % 3u;
-    // The corners as shading reads them (with the positions), the light, and one corner alone (as alpha.wgsl does).
-    probe_out[2u * i] = vec4<u32>(scene_tri_positions(i).corners, scene_tri_light(i));
-    probe_out[2u * i + 1u] = vec4<u32>(t.corners, scene_tri_corner(i, k));
+    // The corners as shading reads them (with the positions), the light, one corner alone (as alpha.wgsl does),
+    // and that corner's shading vertex.
+    probe_out[3u * i] = vec4<u32>(scene_tri_positions(i).corners, scene_tri_light(i));
+    probe_out[3u * i + 1u] = vec4<u32>(t.corners, scene_tri_corner(i, k));
+    let v = scene_shading_vertex(scene_tri_corner(i, k));
+    probe_out[3u * i + 2u] = vec4<u32>(v.normal, v.material, bitcast<vec2<u32>>(v.uv));
 }
 ";
 
-/// Each triangle's shading-vertex indices travel in the w of its vertices and its light in `tri_lights`
-/// (`SceneData::pack_triangle_records`): the device must read back exactly the CPU's records, in a scene without
-/// emissive triangles (where `tri_lights` is a few INVALID words and a zero padding word would read as light 0) and
-/// in one with 80,640 of them.
+/// Each triangle's shading-vertex records travel in the w of its vertices and its light in `tri_lights`
+/// (`SceneData::pack_triangle_records`): the device must read back exactly the CPU's records and shading vertices,
+/// in a scene without emissive triangles (where `tri_lights` is a few INVALID words and a zero padding word would
+/// read as light 0), in one with 80,640 of them, and in a textured one (two records per vertex: the uv too).
 #[test]
 fn gpu_reads_every_triangle_record_as_the_cpu_wrote_it() {
     use mislab::render::gpu_scene::GpuScene;
@@ -204,13 +207,17 @@ fn gpu_reads_every_triangle_record_as_the_cpu_wrote_it() {
     let pipelines = ScenePipelines::new(&ctx, &source, &["probe_records"]).expect("probe pipelines");
     let helmet =
         concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes/damagedhelmet_grey/damagedhelmet_grey.toml");
-    for (name, emitters) in [(helmet, false), ("veach-mis-triangles", true)] {
+    let textured = format!("{TESTDATA}/BoxTextured/glTF/BoxTextured.gltf");
+    for (name, emitters) in [(helmet, false), ("veach-mis-triangles", true), (textured.as_str(), false)] {
         let data = SceneData::build(&common::scene(name));
+        let stride = data.shading_record_stride();
+        assert_eq!(stride, if name == textured { 2 } else { 1 }, "{name}: records per shading vertex");
         let n = data.tri_shading.len();
         assert_eq!(data.tri_shading.iter().any(|t| t.light != mislab::gpu::types::INVALID), emitters, "{name}");
         for (i, t) in data.tri_shading.iter().enumerate() {
             for k in 0..3 {
-                assert_eq!(data.tri_verts[3 * i + k][3].to_bits(), t.corners[k], "{name}: triangle {i} corner {k}");
+                let w = data.tri_verts[3 * i + k][3].to_bits();
+                assert_eq!(w, stride * t.corners[k], "{name}: triangle {i} corner {k}");
             }
         }
         assert_eq!(data.tri_lights.len(), if emitters { n } else { 4 }, "{name}: tri_lights");
@@ -218,13 +225,19 @@ fn gpu_reads_every_triangle_record_as_the_cpu_wrote_it() {
         let frame = Default::default();
         let job = [n as u32, 0, 0, 0];
         let out = pipelines
-            .dispatch(&ctx, "probe_records", &bound, &frame, bytemuck::cast_slice(&job), &[], 32 * n as u64, n as u32)
+            .dispatch(&ctx, "probe_records", &bound, &frame, bytemuck::cast_slice(&job), &[], 48 * n as u64, n as u32)
             .expect("dispatch");
         let out: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&out);
         for (i, t) in data.tri_shading.iter().enumerate() {
-            let c = t.corners;
-            assert_eq!(out[2 * i], [c[0], c[1], c[2], t.light], "{name}: triangle {i} (positions' corners, light)");
-            assert_eq!(out[2 * i + 1], [c[0], c[1], c[2], c[i % 3]], "{name}: triangle {i} (record, one corner)");
+            let c = t.corners.map(|c| stride * c);
+            assert_eq!(out[3 * i], [c[0], c[1], c[2], t.light], "{name}: triangle {i} (positions' corners, light)");
+            assert_eq!(out[3 * i + 1], [c[0], c[1], c[2], c[i % 3]], "{name}: triangle {i} (record, one corner)");
+            let v = data.shading_verts[t.corners[i % 3] as usize];
+            let got = out[3 * i + 2];
+            assert_eq!([got[0], got[1]], [v.normal, v.material], "{name}: triangle {i} shading vertex");
+            if stride == 2 {
+                assert_eq!([got[2], got[3]], v.uv.map(f32::to_bits), "{name}: triangle {i} uv");
+            }
         }
     }
 }

@@ -181,7 +181,11 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     out += "fn scene_tri_corner(i: u32, k: u32) -> u32 { return scene_tri_record(i).corners[k]; }\n\
             fn scene_tri_light(i: u32) -> u32 { return scene_tri_record(i).light; }\n";
     let vertex = wgsl_members("ShadingVertex");
-    out += &accessor("scene_shading_vertex", "ShadingVertex", &vertex, &data.shading_verts, "shading_verts[i]");
+    // Indexed by vertex here (the corners above are `tri_shading`'s); the buffer holds `stride` records per vertex.
+    let stride = data.shading_record_stride();
+    let uv = if stride == 2 { "bitcast<vec2<f32>>(shading_verts[2u * i + 1u])" } else { "vec2<f32>(0.0)" };
+    let read = format!("ShadingVertex(shading_verts[{stride}u * i].x, shading_verts[{stride}u * i].y, {uv})");
+    out += &accessor("scene_shading_vertex", "ShadingVertex", &vertex, &data.shading_verts, &read);
     out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "spheres[i]");
     out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "quads[i]");
     out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");

@@ -145,8 +145,12 @@ pub const SCENE: [SceneBinding; 17] = [
         bytes: |d| bytemuck::cast_slice(&d.wide_nodes),
     },
     SceneBinding {
-        binding: scene(15, "shading_verts", "array<ShadingVertex>", size_of::<GpuShadingVertex>(), "shading vertices"),
-        bytes: |d| bytemuck::cast_slice(&d.shading_verts),
+        binding: Binding {
+            note: "Per shading vertex (normal, material word) and, where the scene has textures, its uv's bits \
+                   (SceneData::shading_records).",
+            ..scene(15, "shading_verts", "array<vec2<u32>>", 8, "shading vertex records")
+        },
+        bytes: |d| bytemuck::cast_slice(&d.shading_records),
     },
     SceneBinding {
         binding: Binding {

@@ -7,7 +7,7 @@ use crate::gpu::types::*;
 use crate::render::lights::{self, luminance};
 use crate::render::shading_data::{material_word, word_material, ShadingTable};
 use crate::scene::{Environment, PunctualLight, Scene, TextureRef, Wrap};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 
 /// `tri_lights` of a scene where no triangle emits. Four words, not one: a storage buffer is at least 16 bytes
@@ -33,8 +33,13 @@ pub struct SceneData {
     /// Each triangle's light (index in the light table, or INVALID), or `NO_TRI_LIGHTS` when no triangle emits: 4
     /// bytes per triangle only in scenes with emissive triangles.
     pub tri_lights: Vec<u32>,
-    /// Distinct shading vertices (normal, material, uv), indexed by `tri_shading`.
+    /// Distinct shading vertices (normal, material, uv), indexed by `tri_shading`. In a scene without textures
+    /// nothing reads a uv, so every uv is zero (more vertices are shared) and none is uploaded.
     pub shading_verts: Vec<GpuShadingVertex>,
+    /// The upload form of `shading_verts` (`pack_triangle_records`): per vertex one record (normal, material
+    /// word) and, where the scene has textures, a second one with its uv's bits; a triangle corner's w holds the
+    /// index of its vertex's first record. 8 bytes per vertex in a scene without textures, 16 with.
+    pub shading_records: Vec<[u32; 2]>,
     /// Spheres.
     pub spheres: Vec<GpuSphere>,
     /// Quads.
@@ -121,6 +126,8 @@ impl SceneData {
         };
         let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(scene.triangle_count());
         let mut shading = ShadingTable::default();
+        // Only textures read uvs (shaders/surface.wgsl): without any, uvs are dropped (SceneData::shading_records).
+        let keep_uvs = !scene.textures.is_empty();
         for mesh in &scene.meshes {
             let word = material_word(mat_index(mesh.material), alpha_of(mesh.material));
             // Each mesh vertex's shading vertex, encoded once (INVALID: not yet).
@@ -135,7 +142,8 @@ impl SceneData {
                     let i = i as usize;
                     if shared[i] == INVALID {
                         let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
-                        shared[i] = shading.vertex(n, mesh.uvs.get(i).copied().unwrap_or_default(), word);
+                        let uv = if keep_uvs { mesh.uvs.get(i).copied().unwrap_or_default() } else { Vec2::ZERO };
+                        shared[i] = shading.vertex(n, uv, word);
                     }
                     shared[i]
                 });
@@ -203,13 +211,25 @@ impl SceneData {
         d
     }
 
-    /// Writes `tri_shading` into the upload form: corner k's shading-vertex index into the w of vertex k of the
-    /// triangle (a vertex is a vec4 for alignment, so this costs nothing), the lights into `tri_lights`. Shading a
-    /// hit then reads the index with the positions it already loads (shaders/scene_data.wgsl).
+    /// Writes `tri_shading` and `shading_verts` into the upload form: the shading vertices as `shading_records`
+    /// (a second record with the uv only where the scene has textures, the predicate of `Features::textures`,
+    /// which is what makes shaders/scene_data.wgsl read it), corner k's first record index into the w of vertex k
+    /// of the triangle (a vertex is a vec4 for alignment, so this costs nothing), the lights into `tri_lights`.
+    /// Shading a hit then reads the index with the positions it already loads.
     pub fn pack_triangle_records(&mut self) {
+        let stride = self.shading_record_stride();
+        self.shading_records = self
+            .shading_verts
+            .iter()
+            .flat_map(|v| [[v.normal, v.material], v.uv.map(f32::to_bits)].into_iter().take(stride as usize))
+            .collect();
+        if stride == 1 {
+            // The generic pipeline (HAS_TEXTURES) reads a record past the last vertex's; it gets zeros.
+            self.shading_records.push([0, 0]);
+        }
         for (i, t) in self.tri_shading.iter().enumerate() {
             for (k, &c) in t.corners.iter().enumerate() {
-                self.tri_verts[3 * i + k][3] = f32::from_bits(c);
+                self.tri_verts[3 * i + k][3] = f32::from_bits(c * stride);
             }
         }
         self.tri_lights = if self.tri_shading.iter().any(|t| t.light != INVALID) {
@@ -217,6 +237,16 @@ impl SceneData {
         } else {
             NO_TRI_LIGHTS.to_vec()
         };
+    }
+
+    /// Records per shading vertex in `shading_records`: 2 (normal and material, uv) where the scene has textures,
+    /// else 1.
+    pub fn shading_record_stride(&self) -> u32 {
+        if self.tex_info.is_empty() {
+            1
+        } else {
+            2
+        }
     }
 
     /// Nodes of the BVH in use, and its kind ("8-wide" or "binary").

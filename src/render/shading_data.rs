@@ -1,7 +1,8 @@
 //! Compact shading data: per triangle its three shading-vertex indices, which travel in the w words of its three
 //! `tri_verts` (free: a vertex is a vec4 for alignment; `SceneData::pack_triangle_records`), and its light, in
 //! `tri_lights` only where some triangle emits; per distinct shading vertex 16 bytes (an octahedral normal, the
-//! material word, the uv as two f32). `GpuTriShading` is the CPU's view of a triangle's record.
+//! material word, the uv as two f32), or 8 in a scene without textures, where nothing reads a uv and none is kept
+//! (`SceneData::shading_records`). `GpuTriShading` is the CPU's view of a triangle's record.
 //!
 //! Why indexed rather than packed per triangle: 32 bytes per triangle leave no room for f32 uvs next to three
 //! normals, and f16 uvs (or f16 uv deltas) fail where tiling needs the range: a 100-tile floor triangle's corner
