@@ -375,24 +375,15 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             data.bvh_sah,
             data.bvh_bytes()
         );
-        // Device memory per triangle: BVH (nodes and primitive references), geometry
-        // (vertices, carrying each corner's shading-vertex index) and shading data (the triangles' lights where some
-        // emit, and the shared shading vertices).
-        let tris = data.tri_shading.len().max(1) as f64;
-        let sizes = mislab::render::gpu_scene::binding_sizes(&data);
-        let size = |name: &str| {
-            let table = mislab::render::bindings::SCENE.iter();
-            table.zip(sizes).filter(|(b, _)| b.binding.name == name).map(|(_, s)| s).sum::<u64>()
-        };
-        let (bvh, geom) = (size("bvh_nodes") + size("prim_refs") + size("wide_nodes"), size("tri_verts"));
-        let shading = size("tri_lights") + size("shading_verts");
+        let m = mislab::render::gpu_scene::memory_per_triangle(&data);
+        let every = mislab::render::gpu_scene::binding_sizes(&data).iter().sum::<u64>();
         println!(
             "memory per triangle: BVH {:.0} B, geometry {:.0} B, shading {:.0} B, total {:.0} B; every scene buffer {:.1} MiB",
-            bvh as f64 / tris,
-            geom as f64 / tris,
-            shading as f64 / tris,
-            (bvh + geom + shading) as f64 / tris,
-            sizes.iter().sum::<u64>() as f64 / (1u64 << 20) as f64
+            m.bvh,
+            m.geometry,
+            m.shading,
+            m.total(),
+            every as f64 / (1u64 << 20) as f64
         );
         let features = mislab::render::features::Features::of(&data);
         println!("features (code paths compiled into its specialised pipelines): {}", features.describe());

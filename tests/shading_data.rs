@@ -241,3 +241,17 @@ fn gpu_reads_every_triangle_record_as_the_cpu_wrote_it() {
         }
     }
 }
+
+/// Issue 13's budget: BVH + geometry + shading data within 64 bytes per triangle on the bench scenes (grey
+/// models and interiors, and the scaling series), as `mislab info` reports it.
+#[test]
+fn bench_scenes_fit_in_64_bytes_per_triangle() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes");
+    for name in ["damagedhelmet_grey", "livingroom_grey", "staircase2_grey", "scaling_1k", "scaling_100k"] {
+        let data = SceneData::build(&common::scene(&format!("{dir}/{name}/{name}.toml")));
+        let m = mislab::render::gpu_scene::memory_per_triangle(&data);
+        eprintln!("{name}: {m:?}, total {:.1} B", m.total());
+        assert!(data.tri_shading.len() > 900, "{name}: {} triangles", data.tri_shading.len());
+        assert!(m.total() <= 64.0, "{name}: {:.1} bytes per triangle ({m:?})", m.total());
+    }
+}

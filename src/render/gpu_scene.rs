@@ -19,6 +19,38 @@ pub fn binding_sizes(data: &SceneData) -> [u64; bindings::SCENE.len()] {
     bindings::SCENE.map(|b| (b.bytes)(data).len() as u64)
 }
 
+/// Device memory per triangle (bytes) of what scales with the triangles, as `mislab info` reports it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleMemory {
+    /// BVH: nodes (binary and 8-wide) and primitive references.
+    pub bvh: f64,
+    /// Vertices (carrying each corner's shading-vertex record index).
+    pub geometry: f64,
+    /// The triangles' lights (where some emit) and the shared shading-vertex records.
+    pub shading: f64,
+}
+
+impl TriangleMemory {
+    pub fn total(&self) -> f64 {
+        self.bvh + self.geometry + self.shading
+    }
+}
+
+/// [`TriangleMemory`] of a scene (counts with one triangle where it has none).
+pub fn memory_per_triangle(data: &SceneData) -> TriangleMemory {
+    let sizes = binding_sizes(data);
+    let size = |names: &[&str]| -> f64 {
+        let table = bindings::SCENE.iter().zip(sizes);
+        table.filter(|(b, _)| names.contains(&b.binding.name)).map(|(_, s)| s).sum::<u64>() as f64
+    };
+    let tris = data.tri_shading.len().max(1) as f64;
+    TriangleMemory {
+        bvh: size(&["bvh_nodes", "prim_refs", "wide_nodes"]) / tris,
+        geometry: size(&["tri_verts"]) / tris,
+        shading: size(&["tri_lights", "shading_verts"]) / tris,
+    }
+}
+
 /// Checks every group-0 buffer against a device's storage-buffer binding limit (bytes). The error names the
 /// buffer, its size and the limit, so that the user knows what to shrink.
 pub fn check_binding_sizes(data: &SceneData, limit: u64) -> Result<(), GpuError> {
