@@ -214,7 +214,19 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
 /// (src/render/scene_data.rs `pack_triangle_records`), whose bits as an f32 are a denormal, and lavapipe runs
 /// shaders with denormals flushed to zero, so it must never pass through a float register.
 fn tri_position(k: u32) -> vec3<f32> {
-    return bitcast<vec3<f32>>(tri_verts[k].xyz);
+    return bitcast<vec3<f32>>(tri_vertex_words(k).xyz);
+}
+
+/// Vertex k of `tri_verts` as words (position bits, corner record index). In a scene whose vertices exceed one
+/// binding, those past the first binding's length are in `tri_verts_hi` (src/render/gpu_scene.rs split_vertices).
+fn tri_vertex_words(k: u32) -> vec4<u32> {
+    if HAS_GEOMETRY_SPLIT {
+        let n = arrayLength(&tri_verts);
+        if k >= n {
+            return tri_verts_hi[k - n];
+        }
+    }
+    return tri_verts[k];
 }
 
 /// A child reference in one word, as the traversal stack and the leaf queue hold it: an interior node's index

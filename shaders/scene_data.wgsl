@@ -15,13 +15,13 @@ struct TriPositions {
 }
 
 fn scene_tri_positions(i: u32) -> TriPositions {
-    let a = tri_verts[3u * i];
-    let b = tri_verts[3u * i + 1u];
-    let c = tri_verts[3u * i + 2u];
+    let a = tri_vertex_words(3u * i);
+    let b = tri_vertex_words(3u * i + 1u);
+    let c = tri_vertex_words(3u * i + 2u);
     return TriPositions(bitcast<vec3<f32>>(a.xyz), bitcast<vec3<f32>>(b.xyz), bitcast<vec3<f32>>(c.xyz), vec3<u32>(a.w, b.w, c.w));
 }
 /// Corner k's shading-vertex index alone (one load).
-fn scene_tri_corner(i: u32, k: u32) -> u32 { return tri_verts[3u * i + k].w; }
+fn scene_tri_corner(i: u32, k: u32) -> u32 { return tri_vertex_words(3u * i + k).w; }
 /// The triangle's light, or INVALID. Where no triangle emits, `tri_lights` is a few INVALID words
 /// (src/render/scene_data.rs `NO_TRI_LIGHTS`), and the clamped index reads one of them.
 fn scene_tri_light(i: u32) -> u32 {

@@ -173,6 +173,38 @@ fn texels_split_over_two_bindings_render_as_one() {
     assert!(msg.contains("texels") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
 }
 
+/// A scene whose vertices exceed the binding limit the renderer believes takes them over two bindings
+/// (gpu_scene::split_vertices, at a triangle boundary) and renders bit for bit as with one; past two bindings it
+/// is a clear error.
+#[test]
+fn vertices_split_over_two_bindings_render_as_one() {
+    use mislab::render::{features::Features, gpu_scene::GpuScene, Renderer};
+    let ctx = common::gpu();
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes/scaling_1k/scaling_1k.toml");
+    let scene = common::scene(file);
+    let data = SceneData::build(&scene);
+    let bytes = 16 * data.tri_verts.len() as u64;
+    let render = |gs: &GpuScene| {
+        let mut r = Renderer::new(&ctx, gs, scene.camera.clone(), common::small(32, 32)).expect("renderer");
+        r.render(&ctx, 2).expect("render");
+        r.film(&ctx).expect("readback")
+    };
+    let whole = GpuScene::upload(&ctx, data.clone()).expect("upload");
+    assert!(whole.data.tri_verts_hi.is_empty() && !Features::of(&whole.data).geometry_split);
+    // A limit that cuts the vertices in the middle of a triangle's three.
+    let limit = bytes * 3 / 5 + 16;
+    let split = GpuScene::upload_with_limit(&ctx, data.clone(), limit).expect("split upload");
+    let (lo, hi) = (split.data.tri_verts.len(), split.data.tri_verts_hi.len());
+    assert!(lo % 3 == 0 && lo + hi == data.tri_verts.len() && 16 * lo as u64 <= limit && hi > 0, "{lo} + {hi}");
+    assert!(Features::of(&split.data).geometry_split);
+    let (a, b) = (render(&whole), render(&split));
+    assert!(a.mean.iter().flatten().any(|&c| c > 0.0), "black render");
+    assert_eq!(a.mean, b.mean, "split vertices render differently");
+    let err = GpuScene::upload_with_limit(&ctx, data, bytes / 3).err().expect("vertices in three bindings' worth");
+    let msg = err.to_string();
+    assert!(msg.contains("triangle vertices") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
+}
+
 const RECORD_PROBE: &str = "
 @group(2) @binding(0) var<uniform> probe_count: vec4<u32>;
 @group(2) @binding(1) var<storage, read_write> probe_out: array<vec4<u32>>;

@@ -60,24 +60,30 @@ const fn scene(
     Binding { group: 0, binding, name, wgsl_type, access: Access::Read, element_size, label, note: "" }
 }
 
-/// Bindings 0–4 of group 0 and [`WIDE_NODES`] are the geometry (what BVH traversal reads; the probe kernels bind
-/// these alone).
+/// Bindings 0–4 of group 0, [`WIDE_NODES`] and [`TRI_VERTS_HI`] are the geometry (what BVH traversal reads; the
+/// probe kernels bind these alone).
 pub const GEOMETRY_BINDINGS: u32 = 5;
 /// The binding (and `SCENE` index) of the wide BVH's nodes, a geometry binding added after the shading ones.
 pub const WIDE_NODES: usize = 14;
+/// The binding (and `SCENE` index) of the vertices beyond the first vertex binding, a geometry binding.
+pub const TRI_VERTS_HI: usize = 17;
+
+fn is_geometry(i: usize) -> bool {
+    i < GEOMETRY_BINDINGS as usize || i == WIDE_NODES || i == TRI_VERTS_HI
+}
 
 /// The geometry bindings of group 0, in binding order.
 pub fn geometry() -> impl Iterator<Item = &'static SceneBinding> {
-    SCENE[..GEOMETRY_BINDINGS as usize].iter().chain(std::iter::once(&SCENE[WIDE_NODES]))
+    SCENE.iter().enumerate().filter(|(i, _)| is_geometry(*i)).map(|(_, b)| b)
 }
 
 /// The other bindings of group 0 (materials, lights, textures, environment).
 pub fn shading() -> impl Iterator<Item = &'static SceneBinding> {
-    SCENE.iter().enumerate().filter(|(i, _)| *i >= GEOMETRY_BINDINGS as usize && *i != WIDE_NODES).map(|(_, b)| b)
+    SCENE.iter().enumerate().filter(|(i, _)| !is_geometry(*i)).map(|(_, b)| b)
 }
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 17] = [
+pub const SCENE: [SceneBinding; 18] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -159,6 +165,14 @@ pub const SCENE: [SceneBinding; 17] = [
         },
         bytes: |d| bytemuck::cast_slice(&d.tex_texels_hi),
     },
+    SceneBinding {
+        binding: Binding {
+            note: "Vertices beyond tri_verts when they exceed one binding (src/render/gpu_scene.rs split_vertices); \
+                   one zero vertex otherwise.",
+            ..scene(17, "tri_verts_hi", "array<vec4<u32>>", 16, "triangle vertices beyond the first binding")
+        },
+        bytes: |d| bytemuck::cast_slice(&d.tri_verts_hi),
+    },
 ];
 
 /// Group 1: the per-render state, in binding order.
@@ -223,7 +237,7 @@ pub fn wgsl_declaration(b: &Binding) -> String {
     format!("{note}@group({}) @binding({}) {var} {}: {};\n", b.group, b.binding, b.name, b.wgsl_type)
 }
 
-/// `geometry_bindings.wgsl`: the geometry bindings (group 0, 0–4 and 14), for BVH traversal.
+/// `geometry_bindings.wgsl`: the geometry bindings (group 0: 0–4, 14 and 17), for BVH traversal.
 pub fn geometry_wgsl() -> String {
     let mut s =
         String::from("// geometry_bindings.wgsl — generated from src/render/bindings.rs: the scene's geometry.\n\n");

@@ -43,6 +43,9 @@ pub struct Features {
     pub checkerboard: bool,
     /// Texels over two bindings (`gpu_scene::split_texels`): texel reads look at `TEXEL_HI`.
     pub texel_split: bool,
+    /// Vertices over two bindings (`gpu_scene::split_vertices`): vertex reads past `tri_verts` go to
+    /// `tri_verts_hi`.
+    pub geometry_split: bool,
     /// Any material with a GGX lobe.
     pub specular: bool,
     /// Any material with a diffuse lobe.
@@ -85,6 +88,7 @@ impl Features {
             textures: true,
             checkerboard: true,
             texel_split: true,
+            geometry_split: true,
             specular: true,
             diffuse: true,
             conductor: true,
@@ -123,6 +127,7 @@ impl Features {
             textures: !data.tex_info.is_empty(),
             checkerboard: data.tex_info.iter().any(|t| t.tex_kind == TEX_CHECKERBOARD),
             texel_split: data.tex_info.iter().any(|t| t.offset & TEXEL_HI != 0),
+            geometry_split: !data.tri_verts_hi.is_empty(),
             specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
             diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
             conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
@@ -158,6 +163,7 @@ impl Features {
             ("HAS_TEXTURES", b(self.textures)),
             ("HAS_CHECKERBOARD", b(self.checkerboard)),
             ("HAS_TEXEL_SPLIT", b(self.texel_split)),
+            ("HAS_GEOMETRY_SPLIT", b(self.geometry_split)),
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
             ("HAS_CONDUCTOR", b(self.conductor)),
@@ -189,6 +195,7 @@ impl Features {
         on("textures", self.textures);
         on("checkerboard textures", self.checkerboard);
         on("texels over two bindings", self.texel_split);
+        on("vertices over two bindings", self.geometry_split);
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);

@@ -46,7 +46,7 @@ pub fn memory_per_triangle(data: &SceneData) -> TriangleMemory {
     let tris = data.tri_shading.len().max(1) as f64;
     TriangleMemory {
         bvh: size(&["bvh_nodes", "prim_refs", "wide_nodes"]) / tris,
-        geometry: size(&["tri_verts"]) / tris,
+        geometry: size(&["tri_verts", "tri_verts_hi"]) / tris,
         shading: size(&["tri_lights", "shading_verts"]) / tris,
     }
 }
@@ -86,9 +86,27 @@ pub fn split_texels(data: &mut SceneData, limit: u64) -> Result<(), GpuError> {
     Ok(())
 }
 
+/// Vertices beyond one storage binding of `limit` bytes move to the second vertex binding (`tri_verts_hi`), split
+/// at a triangle boundary; the shader reads vertex k from it when k is past `tri_verts`' length (and
+/// `Features::geometry_split` compiles that read in). Past two bindings: `GpuError::VerticesTooLarge`.
+pub fn split_vertices(data: &mut SceneData, limit: u64) -> Result<(), GpuError> {
+    let bytes = 16 * (data.tri_verts.len() + data.tri_verts_hi.len()) as u64;
+    if 16 * data.tri_verts.len() as u64 <= limit || !data.tri_verts_hi.is_empty() {
+        return Ok(());
+    }
+    let cut = 3 * (limit / 48) as usize;
+    let second = bytes - 16 * cut as u64;
+    if second > limit {
+        return Err(GpuError::VerticesTooLarge { bytes, second, limit });
+    }
+    data.tri_verts_hi = data.tri_verts.split_off(cut);
+    Ok(())
+}
+
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
-    /// larger than the device's storage-buffer binding limit; texels may take two bindings (`split_texels`).
+    /// larger than the device's storage-buffer binding limit; texels and vertices may take two bindings
+    /// (`split_texels`, `split_vertices`).
     pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, GpuError> {
         Self::upload_with_limit(ctx, data, u64::MAX)
     }
@@ -98,6 +116,7 @@ impl GpuScene {
     pub fn upload_with_limit(ctx: &GpuContext, mut data: SceneData, limit: u64) -> Result<GpuScene, GpuError> {
         let limit = limit.min(ctx.max_storage_binding());
         split_texels(&mut data, limit)?;
+        split_vertices(&mut data, limit)?;
         check_binding_sizes(&data, limit)?;
         let buffers = bindings::SCENE
             .iter()
