@@ -385,7 +385,17 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             m.total(),
             every as f64 / (1u64 << 20) as f64
         );
-        let features = mislab::render::features::Features::of(&data);
+        // What the upload does on this device: texels or vertices past one binding take a second, or it refuses.
+        let mut uploaded = data.clone();
+        let limit = ctx.max_storage_binding();
+        use mislab::render::gpu_scene::{check_binding_sizes, split_texels, split_vertices};
+        let fits = split_texels(&mut uploaded, limit)
+            .and_then(|_| split_vertices(&mut uploaded, limit))
+            .and_then(|_| check_binding_sizes(&uploaded, limit));
+        if let Err(e) = fits {
+            println!("upload: {e}");
+        }
+        let features = mislab::render::features::Features::of(&uploaded);
         println!("features (code paths compiled into its specialised pipelines): {}", features.describe());
     }
     Ok(0)

@@ -170,8 +170,9 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
             [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], s[0], s[1], s[2]]
         })
         .collect();
+    // The buffer's w words count shading records, not vertices: the corners come from the (always literal) records.
     let tri_read = "TriPositions(tri_position(3u * i), tri_position(3u * i + 1u), tri_position(3u * i + 2u), \
-                    vec3<u32>(tri_verts[3u * i].w, tri_verts[3u * i + 1u].w, tri_verts[3u * i + 2u].w))";
+                    scene_tri_record(i).corners)";
     let members = ["vec3<f32>", "vec3<f32>", "vec3<f32>", "vec3<u32>"].map(String::from);
     out += &accessor("scene_tri_positions", "TriPositions", &members, &positions, tri_read);
     // Every TriShading member is a u32, so this table is always literals (no buffer fallback is ever used).

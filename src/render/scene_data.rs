@@ -227,7 +227,8 @@ impl SceneData {
             .flat_map(|v| [[v.normal, v.material], v.uv.map(f32::to_bits)].into_iter().take(stride as usize))
             .collect();
         if stride == 1 {
-            // The generic pipeline (HAS_TEXTURES) reads a record past the last vertex's; it gets zeros.
+            // The generic pipeline (HAS_TEXTURES) reads the record after a vertex's as its uv: the next vertex's
+            // words (unused: no texture reads a uv here), and for the last vertex this zero record.
             self.shading_records.push([0, 0]);
         }
         for (i, t) in self.tri_shading.iter().enumerate() {
