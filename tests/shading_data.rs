@@ -143,21 +143,30 @@ fn three_textured_quads() -> mislab::scene::Scene {
     scene
 }
 
+/// Two samples per pixel of an uploaded scene at `size`², read back (the split tests compare uploads with it).
+fn two_samples(
+    ctx: &mislab::gpu::GpuContext,
+    gs: &mislab::render::gpu_scene::GpuScene,
+    scene: &mislab::scene::Scene,
+    size: u32,
+) -> mislab::render::film::Film {
+    let settings = common::small(size, size);
+    let mut r = mislab::render::Renderer::new(ctx, gs, scene.camera.clone(), settings).expect("renderer");
+    r.render(ctx, 2).expect("render");
+    r.film(ctx).expect("readback")
+}
+
 /// A scene whose texels exceed the binding limit the renderer believes takes them over two bindings
 /// (gpu_scene::split_texels) and renders bit for bit as with one; past two bindings it is a clear error.
 #[test]
 fn texels_split_over_two_bindings_render_as_one() {
-    use mislab::render::{features::Features, gpu_scene::GpuScene, Renderer};
+    use mislab::render::{features::Features, gpu_scene::GpuScene};
     let ctx = common::gpu();
     let scene = three_textured_quads();
     let data = SceneData::build(&scene);
     let (bytes, n) = (4 * data.tex_texels.len() as u64, data.tex_info.len());
     assert_eq!(n, 3);
-    let render = |gs: &GpuScene| {
-        let mut r = Renderer::new(&ctx, gs, scene.camera.clone(), common::small(40, 40)).expect("renderer");
-        r.render(&ctx, 2).expect("render");
-        r.film(&ctx).expect("readback")
-    };
+    let render = |gs: &GpuScene| two_samples(&ctx, gs, &scene, 40);
     let whole = GpuScene::upload(&ctx, data.clone()).expect("upload");
     assert!(whole.data.tex_texels_hi.is_empty() && !Features::of(&whole.data).texel_split);
     // A limit that cuts the texture list in the middle.
@@ -178,17 +187,13 @@ fn texels_split_over_two_bindings_render_as_one() {
 /// is a clear error.
 #[test]
 fn vertices_split_over_two_bindings_render_as_one() {
-    use mislab::render::{features::Features, gpu_scene::GpuScene, Renderer};
+    use mislab::render::{features::Features, gpu_scene::GpuScene};
     let ctx = common::gpu();
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes/scaling_1k/scaling_1k.toml");
     let scene = common::scene(file);
     let data = SceneData::build(&scene);
     let bytes = 16 * data.tri_verts.len() as u64;
-    let render = |gs: &GpuScene| {
-        let mut r = Renderer::new(&ctx, gs, scene.camera.clone(), common::small(32, 32)).expect("renderer");
-        r.render(&ctx, 2).expect("render");
-        r.film(&ctx).expect("readback")
-    };
+    let render = |gs: &GpuScene| two_samples(&ctx, gs, &scene, 32);
     let whole = GpuScene::upload(&ctx, data.clone()).expect("upload");
     assert!(whole.data.tri_verts_hi.is_empty() && !Features::of(&whole.data).geometry_split);
     // A limit that cuts the vertices in the middle of a triangle's three.
