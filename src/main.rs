@@ -387,12 +387,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
         );
         // What the upload does on this device: texels or vertices past one binding take a second, or it refuses.
         let mut uploaded = data.clone();
-        let limit = ctx.max_storage_binding();
-        use mislab::render::gpu_scene::{check_binding_sizes, split_texels, split_vertices};
-        let fits = split_texels(&mut uploaded, limit)
-            .and_then(|_| split_vertices(&mut uploaded, limit))
-            .and_then(|_| check_binding_sizes(&uploaded, limit));
-        if let Err(e) = fits {
+        if let Err(e) = mislab::render::gpu_scene::fit_to_binding_limit(&mut uploaded, ctx.max_storage_binding()) {
             println!("upload: {e}");
         }
         let features = mislab::render::features::Features::of(&uploaded);

@@ -149,21 +149,11 @@ struct Bvh2View<'a> {
 impl<'a> Bvh2View<'a> {
     fn new(bvh: &'a Bvh) -> Self {
         let nodes = &bvh.nodes;
-        // Children come after their parent in the flattened BVH2 (depth-first), so a reverse sweep sees them first.
+        // The flattened BVH2 is in depth-first preorder (children after their parent), so a reverse sweep over the
+        // indices sees every child before its parent.
         let mut subtree_prims = vec![0u32; nodes.len()];
-        let mut order: Vec<u32> = Vec::with_capacity(nodes.len());
-        let mut stack = vec![0u32];
-        while let Some(i) = stack.pop() {
-            order.push(i);
-            let n = &nodes[i as usize];
-            for (first, count) in [(n.l_first, n.l_count), (n.r_first, n.r_count)] {
-                if count == 0 && first != EMPTY_CHILD {
-                    stack.push(first);
-                }
-            }
-        }
-        for &i in order.iter().rev() {
-            let n = &nodes[i as usize];
+        for i in (0..nodes.len()).rev() {
+            let n = &nodes[i];
             let mut total = 0u32;
             for (first, count) in [(n.l_first, n.l_count), (n.r_first, n.r_count)] {
                 total = total.saturating_add(if count > 0 {
@@ -174,7 +164,7 @@ impl<'a> Bvh2View<'a> {
                     0
                 });
             }
-            subtree_prims[i as usize] = total;
+            subtree_prims[i] = total;
         }
         Bvh2View { nodes, prim_refs: &bvh.prim_refs, subtree_prims }
     }

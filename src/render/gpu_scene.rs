@@ -103,6 +103,14 @@ pub fn split_vertices(data: &mut SceneData, limit: u64) -> Result<(), GpuError> 
     Ok(())
 }
 
+/// Fits a flattened scene to a device's storage-binding limit as the upload does: texels and vertices past one
+/// binding take a second (`split_texels`, `split_vertices`); any buffer still over the limit is an error.
+pub fn fit_to_binding_limit(data: &mut SceneData, limit: u64) -> Result<(), GpuError> {
+    split_texels(data, limit)?;
+    split_vertices(data, limit)?;
+    check_binding_sizes(data, limit)
+}
+
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
     /// larger than the device's storage-buffer binding limit; texels and vertices may take two bindings
@@ -115,9 +123,7 @@ impl GpuScene {
     /// the split path with small scenes through it.
     pub fn upload_with_limit(ctx: &GpuContext, mut data: SceneData, limit: u64) -> Result<GpuScene, GpuError> {
         let limit = limit.min(ctx.max_storage_binding());
-        split_texels(&mut data, limit)?;
-        split_vertices(&mut data, limit)?;
-        check_binding_sizes(&data, limit)?;
+        fit_to_binding_limit(&mut data, limit)?;
         let buffers = bindings::SCENE
             .iter()
             .map(|b| ctx.storage_buffer_bytes(b.binding.name, (b.bytes)(&data), b.binding.element_size))
