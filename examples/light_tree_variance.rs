@@ -12,7 +12,7 @@ fn main() {
     let scene = mislab::scene::builtin::by_name(&name).unwrap_or_else(|| panic!("no built-in scene {name}"));
     let t0 = std::time::Instant::now();
     let d = SceneData::build(&scene);
-    let bounded = d.light_tree.first().map_or(0, |n| n.count as usize);
+    let bounded = d.light_tree.first().map_or(0, |n| n.count() as usize);
     eprintln!(
         "{name}: {bounded} lights in the tree, {} nodes, built in {:.2} s",
         d.light_tree.len(),

@@ -168,26 +168,26 @@ struct Light {
     _pad2: u32,
 }
 
-/// One child's bounds in a light-tree node (src/accel/light_tree.rs): bounds, power φ, orientation cone (axis, cos θo)
-/// and emission spread cos θe of the lights below it.
+/// One child's bounds in a light-tree node, decoded (light_tree.wgsl `light_node_child`): bounds, power φ,
+/// orientation cone (axis, cos θo) and emission spread cos θe of the lights below it.
 struct LightChild {
     lo: vec3<f32>,
-    phi: f32,
     hi: vec3<f32>,
-    cos_o: f32,
+    phi: f32,
     axis: vec3<f32>,
+    cos_o: f32,
     cos_e: f32,
 }
 
-/// A light-tree node: both children's bounds (one load per step down) and where they are: `next*` is a node
-/// index, or LIGHT_LEAF_BIT | a light index, or INVALID (none); bit c of `two_sided`: child c emits both ways.
+/// A light-tree node, both children's bounds compressed to four vec4 (src/accel/light_tree.rs `GpuLightNode` gives
+/// the layout): `head` the box origin and scale exponents, two-sided bits; `boxes` the children's 8-bit box edges
+/// and the count of lights below; `power_axes` their φ and octahedral cone axes; `spread_next` their cone
+/// cosines (snorm16 pairs) and where they are: a node index, or LIGHT_LEAF_BIT | a light index, or INVALID.
 struct LightNode {
-    c0: LightChild,
-    c1: LightChild,
-    next0: u32,
-    next1: u32,
-    two_sided: u32,
-    count: u32,
+    head: vec4<u32>,
+    boxes: vec4<u32>,
+    power_axes: vec4<u32>,
+    spread_next: vec4<u32>,
 }
 
 /// Alias-table entry: take `index` with probability `prob`, else `alias`.

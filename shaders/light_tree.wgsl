@@ -2,12 +2,12 @@
 // give the importance), and the pmf of a given light from a shading point, for MIS. Called by select_light /
 // light_pmf in lights.wgsl.
 //
-// The lights with a position come first in the light table, `light_tree[0].count` of them; the infinite ones
+// The lights with a position come first in the light table, `light_tree[0].boxes.w` of them; the infinite ones
 // (directional, environment) follow. Each infinite light is chosen with the probability of the whole tree:
 // 1 / (infinite + 1), or 1 / infinite without a tree. Each node holds both children's bounds, so a step down is
-// one node load.
+// one node load (four vec4).
 
-/// In a LightNode's next0/next1: the child is a leaf, the low bits its light index (light_tree::LEAF_BIT).
+/// In a LightNode's next words (spread_next.zw): the child is a leaf, the low bits its light index (light_tree::LEAF_BIT).
 const LIGHT_LEAF_BIT: u32 = 0x80000000u;
 
 fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
@@ -63,15 +63,33 @@ fn light_node_importance(node: LightChild, two_sided: bool, p: vec3<f32>, n: vec
     return vec2<f32>(a / max(dot(dn, dn), floor_d2), a / max(dot(df, df), floor_d2));
 }
 
+/// Child c (0 or 1) of `node`, decoded as light_tree::GpuLightNode::child does: box edges p + s·q (s·q is exact,
+/// so this rounds once, as on the CPU), φ, the octahedral axis and the snorm16 cosines.
+fn light_node_child(node: LightNode, c: u32) -> LightChild {
+    let o = bitcast<vec3<f32>>(node.head.xyz);
+    let e = (vec3<u32>(node.head.w) >> vec3<u32>(0u, 8u, 16u)) & vec3<u32>(0xffu);
+    let s = bitcast<vec3<f32>>(e << vec3<u32>(23u));
+    // Bytes 6c .. 6c + 5 of boxes.xyz (lo xyz, hi xyz): w0 holds the first four, w1 the last two.
+    let w0 = select(node.boxes.x, (node.boxes.y >> 16u) | (node.boxes.z << 16u), c == 1u);
+    let w1 = select(node.boxes.y, node.boxes.z >> 16u, c == 1u);
+    let lo = vec3<f32>((vec3<u32>(w0) >> vec3<u32>(0u, 8u, 16u)) & vec3<u32>(0xffu));
+    let hi = vec3<f32>(vec3<u32>(w0 >> 24u, w1 & 0xffu, (w1 >> 8u) & 0xffu));
+    let spread = unpack2x16snorm(node.spread_next[c]);
+    return LightChild(o + s * lo, o + s * hi,
+        bitcast<f32>(node.power_axes[c]), oct_decode(node.power_axes[2u + c]), spread.x, spread.y);
+}
+
 /// The probability of descending into the first child of `node`: the mean of the near and far importances'
 /// shares, by power where neither child has importance (as light_tree::first_child_probability).
 fn tree_first_child_probability(node: LightNode, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    if (node.next1 == INVALID) { return 1.0; }
-    let i0 = light_node_importance(node.c0, (node.two_sided & 1u) != 0u, p, n);
-    let i1 = light_node_importance(node.c1, (node.two_sided & 2u) != 0u, p, n);
+    if (node.spread_next.w == INVALID) { return 1.0; }
+    let c0 = light_node_child(node, 0u);
+    let c1 = light_node_child(node, 1u);
+    let i0 = light_node_importance(c0, (node.head.w & (1u << 24u)) != 0u, p, n);
+    let i1 = light_node_importance(c1, (node.head.w & (1u << 25u)) != 0u, p, n);
     let sum = i0 + i1;
     if (sum.x > 0.0 && sum.y > 0.0) { return 0.5 * (i0.x / sum.x + i0.y / sum.y); }
-    if (node.c0.phi + node.c1.phi > 0.0) { return node.c0.phi / (node.c0.phi + node.c1.phi); }
+    if (c0.phi + c1.phi > 0.0) { return c0.phi / (c0.phi + c1.phi); }
     return 0.5;
 }
 
@@ -82,7 +100,7 @@ struct TreeSplit {
     infinite: u32,
 }
 fn tree_split() -> TreeSplit {
-    let bounded = light_tree[0].count;
+    let bounded = light_tree[0].boxes.w;
     let infinite = params.num_lights - bounded;
     let choices = infinite + select(0u, 1u, bounded > 0u);
     return TreeSplit(select(0.0, 1.0 / f32(choices), bounded > 0u), bounded, infinite);
@@ -107,11 +125,11 @@ fn tree_select_light(u_in: f32, p: vec3<f32>, n: vec3<f32>) -> LightPick {
         if (u < p0) {
             u = min(u / p0, ONE_MINUS_EPSILON);
             pmf *= p0;
-            next = node.next0;
+            next = node.spread_next.z;
         } else {
             u = min((u - p0) / (1.0 - p0), ONE_MINUS_EPSILON);
             pmf *= 1.0 - p0;
-            next = node.next1;
+            next = node.spread_next.w;
         }
         if ((next & LIGHT_LEAF_BIT) != 0u) { break; }
     }
@@ -129,10 +147,10 @@ fn tree_light_pmf(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
         let p0 = tree_first_child_probability(node, p, n);
         if ((trail & 1u) == 0u) {
             pmf *= p0;
-            next = node.next0;
+            next = node.spread_next.z;
         } else {
             pmf *= 1.0 - p0;
-            next = node.next1;
+            next = node.spread_next.w;
         }
         trail = trail >> 1u;
         if ((next & LIGHT_LEAF_BIT) != 0u) { break; }

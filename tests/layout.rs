@@ -90,8 +90,7 @@ fn shared_structs_match() {
             _pad2
         ]
     );
-    check!(m, "LightChild", mislab::accel::light_tree::GpuLightChild, [lo, phi, hi, cos_o, axis, cos_e]);
-    check!(m, "LightNode", mislab::accel::light_tree::GpuLightNode, [c0, c1, next0, next1, two_sided, count]);
+    check!(m, "LightNode", mislab::accel::light_tree::GpuLightNode, [head, boxes, power_axes, spread_next]);
     check!(m, "AliasEntry", GpuAliasEntry, [prob, alias_index]);
     check!(m, "TextureInfo", GpuTextureInfo, [offset, width, height, wrap_s, wrap_t, srgb, nearest, tex_kind]);
     check!(m, "Accum", GpuAccum, [mean, count, m2, nonfinite]);

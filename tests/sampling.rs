@@ -1543,7 +1543,7 @@ fn chi2_light_tree_selection() {
     let h = harness();
     let d = h.data(SceneId::ManyLights);
     let n_lights = d.lights.len();
-    let bounded = d.light_tree[0].count as usize;
+    let bounded = d.light_tree[0].count() as usize;
     assert_eq!(bounded, n_lights - 2, "the tree covers every light but the directional and the sky");
     let mut rows = Vec::new();
     let mut failures = Vec::new();

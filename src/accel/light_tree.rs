@@ -25,6 +25,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use crate::accel::quantise::{quantise, scale_exponent};
+use crate::gpu::octahedral::{oct_decode, oct_encode};
+
 /// In a child reference (`GpuLightNode::next`): the child is a leaf and the low bits are its light-table index.
 pub const LEAF_BIT: u32 = 0x8000_0000;
 /// A child reference that refers to nothing: the second child of a root over a single light.
@@ -52,32 +55,128 @@ pub struct LightBounds {
     pub two_sided: bool,
 }
 
-/// One child's bounds as its parent stores them (WGSL `LightChild`): what the importance needs.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuLightChild {
-    pub lo: [f32; 3],
+/// One child's bounds as the importance reads them (WGSL `LightChild`, decoded from its parent's node by
+/// [`GpuLightNode::child`] on the CPU and `light_node_child` in shaders/light_tree.wgsl).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightChild {
+    pub lo: Vec3,
+    pub hi: Vec3,
     pub phi: f32,
-    pub hi: [f32; 3],
+    pub axis: Vec3,
     pub cos_o: f32,
-    pub axis: [f32; 3],
     pub cos_e: f32,
 }
 
-/// One interior node as the GPU reads it (WGSL `LightNode`): both children's bounds, so that one load gives both
-/// importances of a step down (lavapipe pays per storage load: docs/profile-bvh.md), and where each child is:
-/// `next[c]` is a node index, or [`LEAF_BIT`] | the light's index in the light table, or [`EMPTY`].
+/// One interior node as the GPU reads it (WGSL `LightNode`): both children's bounds, compressed to 64 bytes so that
+/// a step down is four vec4 loads (lavapipe pays per storage load: docs/profile-bvh.md; the f32 layout took seven).
+/// Every field is rounded so that the decoded bounds contain the exact ones: boxes outwards, cones wider.
+/// - `head`: the children's common box origin (f32 bits, xyz) and, in w, the biased exponents of the per-axis
+///   power-of-two scales (bytes 0–2, [`crate::accel::quantise`]) and the two-sided bits (bit 24 + c: child c emits
+///   from both faces);
+/// - `boxes`: xyz hold 12 box bytes, child 0's lo xyz and hi xyz, then child 1's; w: lights below this node (the
+///   root's: how many lights of the table the tree covers);
+/// - `power_axes`: φ of child 0 and 1 (f32 bits), then their cone axes (octahedral, `crate::gpu::octahedral`);
+/// - `spread_next`: per child cos θo (low 16 bits) and cos θe (high 16), snorm16 rounded down; then `next0`,
+///   `next1`: a node index, or [`LEAF_BIT`] | the light's index in the light table, or [`EMPTY`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuLightNode {
-    pub c0: GpuLightChild,
-    pub c1: GpuLightChild,
-    pub next0: u32,
-    pub next1: u32,
-    /// Bit c: child c emits from both sides.
-    pub two_sided: u32,
-    /// Lights below this node (the root's: how many lights of the table the tree covers).
-    pub count: u32,
+    pub head: [u32; 4],
+    pub boxes: [u32; 4],
+    pub power_axes: [u32; 4],
+    pub spread_next: [u32; 4],
+}
+
+/// Widening of a cone for its axis' octahedral rounding beyond the measured angle: the GPU's normalize may differ
+/// from the CPU's by a few ulps (~1e-7 rad).
+const AXIS_MARGIN: f64 = 1e-5;
+
+/// snorm16 code of a cosine, rounded down (one more step unless exact, so that a decode that differs from the
+/// CPU's by an ulp is still ≤ the exact cosine): a wider cone.
+fn cos_code_down(c: f64) -> u32 {
+    let x = c.clamp(-1.0, 1.0) * 32767.0;
+    let q = if x == x.floor() { x as i32 } else { x.floor() as i32 - 1 };
+    q.clamp(-32767, 32767) as i16 as u16 as u32
+}
+
+/// CPU twin of WGSL's unpack2x16snorm for one half.
+fn snorm16_decode(bits: u32) -> f32 {
+    ((bits as u16 as i16) as f32 / 32767.0).max(-1.0)
+}
+
+impl GpuLightNode {
+    /// Packs two children (child 1 absent for a root over a single light) and where they are.
+    fn pack(c0: &LightBounds, c1: Option<&LightBounds>, next: [u32; 2], count: u32) -> GpuLightNode {
+        let (lo, hi) = match c1 {
+            Some(c1) => (c0.lo.min(c1.lo), c0.hi.max(c1.hi)),
+            None => (c0.lo, c0.hi),
+        };
+        let e = [0, 1, 2].map(|k| scale_exponent(lo[k], hi[k]));
+        let s = Vec3::from_array(e.map(|e| f32::from_bits(e << 23)));
+        let mut bytes = [0u32; 12];
+        let mut node = GpuLightNode::default();
+        for (c, b) in [Some(c0), c1].into_iter().enumerate() {
+            let Some(b) = b else { continue };
+            for k in 0..3 {
+                let (ql, qh) = quantise(lo[k], s[k], b.lo[k], b.hi[k]);
+                (bytes[6 * c + k], bytes[6 * c + 3 + k]) = (ql, qh);
+            }
+            let axis = oct_encode(b.axis);
+            // The cone about the decoded axis that contains the cone about the exact one.
+            let err = oct_decode(axis).as_dvec3().angle_between(b.axis.as_dvec3().normalize());
+            let theta_o = (b.cos_o.clamp(-1.0, 1.0) as f64).acos() + err + AXIS_MARGIN;
+            // A full sphere of directions, or an axis that does not encode (never for a union of unit normals).
+            let full = b.cos_o <= -1.0 || !(theta_o < std::f64::consts::PI);
+            // In f64: a cone widened by ~1e-5 rad has a cosine that rounds to 1 in f32.
+            let cos_o = if full { -1.0 } else { theta_o.cos() };
+            node.power_axes[c] = b.phi.to_bits();
+            node.power_axes[2 + c] = axis;
+            node.spread_next[c] = cos_code_down(cos_o) | cos_code_down(b.cos_e as f64) << 16;
+            node.head[3] |= (b.two_sided as u32) << (24 + c);
+        }
+        for k in 0..3 {
+            node.head[k] = lo[k].to_bits();
+            node.head[3] |= e[k] << (8 * k);
+        }
+        for (i, q) in bytes.iter().enumerate() {
+            node.boxes[i / 4] |= q << (8 * (i % 4));
+        }
+        node.boxes[3] = count;
+        (node.spread_next[2], node.spread_next[3]) = (next[0], next[1]);
+        node
+    }
+
+    /// Child c's bounds, decoded as the shader decodes them.
+    pub fn child(&self, c: usize) -> LightChild {
+        let o = Vec3::new(f32::from_bits(self.head[0]), f32::from_bits(self.head[1]), f32::from_bits(self.head[2]));
+        let s = Vec3::from_array([0, 1, 2].map(|k| f32::from_bits(((self.head[3] >> (8 * k)) & 0xff) << 23)));
+        let byte = |i: usize| ((self.boxes[i / 4] >> (8 * (i % 4))) & 0xff) as f32;
+        let q = |first: usize| Vec3::new(byte(first), byte(first + 1), byte(first + 2));
+        let spread = self.spread_next[c];
+        LightChild {
+            lo: o + s * q(6 * c),
+            hi: o + s * q(6 * c + 3),
+            phi: f32::from_bits(self.power_axes[c]),
+            axis: oct_decode(self.power_axes[2 + c]),
+            cos_o: snorm16_decode(spread & 0xffff),
+            cos_e: snorm16_decode(spread >> 16),
+        }
+    }
+
+    /// Whether child c emits from both faces.
+    pub fn two_sided(&self, c: usize) -> bool {
+        self.head[3] & (1 << (24 + c)) != 0
+    }
+
+    /// Where child c is: a node index, [`LEAF_BIT`] | a light index, or [`EMPTY`].
+    pub fn next(&self, c: usize) -> u32 {
+        self.spread_next[2 + c]
+    }
+
+    /// Lights below this node.
+    pub fn count(&self) -> u32 {
+        self.boxes[3]
+    }
 }
 
 /// A built tree: nodes depth-first from the root, and each light's root-to-leaf trail.
@@ -112,17 +211,6 @@ impl LightBounds {
 
     fn centroid(&self) -> Vec3 {
         0.5 * (self.lo + self.hi)
-    }
-
-    fn to_child(self) -> GpuLightChild {
-        GpuLightChild {
-            lo: self.lo.into(),
-            phi: self.phi,
-            hi: self.hi.into(),
-            cos_o: self.cos_o,
-            axis: self.axis.into(),
-            cos_e: self.cos_e,
-        }
     }
 }
 
@@ -176,14 +264,14 @@ const MIN_DIST2: f32 = 1e-12;
 /// The importance of a child seen from p with surface normal n (module docs): (near, far), with the closest and
 /// the farthest distance to its box. The same arithmetic, in the same order, as `light_node_importance` in
 /// shaders/light_tree.wgsl (f32 both), so CPU and GPU pmfs agree closely.
-pub fn importance(node: &GpuLightChild, two_sided: bool, p: Vec3, n: Vec3) -> (f32, f32) {
-    let (lo, hi) = (Vec3::from(node.lo), Vec3::from(node.hi));
+pub fn importance(node: &LightChild, two_sided: bool, p: Vec3, n: Vec3) -> (f32, f32) {
+    let (lo, hi) = (node.lo, node.hi);
     let pc = 0.5 * (lo + hi);
     let r2 = 0.25 * (hi - lo).length_squared();
     let to_p = p - pc;
     let dist2 = to_p.length_squared();
     let wi = if dist2 > 0.0 { to_p / dist2.sqrt() } else { Vec3::Z };
-    let mut cos_w = Vec3::from(node.axis).dot(wi);
+    let mut cos_w = node.axis.dot(wi);
     if two_sided {
         cos_w = cos_w.abs();
     }
@@ -219,16 +307,17 @@ pub fn importance(node: &GpuLightChild, two_sided: bool, p: Vec3, n: Vec3) -> (f
 /// any (conservative bounds can give a node importance whose children both have none: descending by power
 /// there keeps Σ pmf = 1 at every point, at the cost of a wasted sample where no light reaches p anyway).
 pub fn first_child_probability(node: &GpuLightNode, p: Vec3, n: Vec3) -> f32 {
-    if node.next1 == EMPTY {
+    if node.next(1) == EMPTY {
         return 1.0;
     }
-    let (n0, f0) = importance(&node.c0, node.two_sided & 1 != 0, p, n);
-    let (n1, f1) = importance(&node.c1, node.two_sided & 2 != 0, p, n);
+    let (c0, c1) = (node.child(0), node.child(1));
+    let (n0, f0) = importance(&c0, node.two_sided(0), p, n);
+    let (n1, f1) = importance(&c1, node.two_sided(1), p, n);
     if n0 + n1 > 0.0 && f0 + f1 > 0.0 {
         return 0.5 * (n0 / (n0 + n1) + f0 / (f0 + f1));
     }
-    if node.c0.phi + node.c1.phi > 0.0 {
-        return node.c0.phi / (node.c0.phi + node.c1.phi);
+    if c0.phi + c1.phi > 0.0 {
+        return c0.phi / (c0.phi + c1.phi);
     }
     0.5
 }
@@ -243,10 +332,7 @@ impl LightTree {
         match items.len() {
             0 => {}
             1 => {
-                let c0 = lights[0].to_child();
-                let two_sided = lights[0].two_sided as u32;
-                let next0 = LEAF_BIT | light_index[0];
-                tree.nodes.push(GpuLightNode { c0, next0, next1: EMPTY, two_sided, count: 1, ..Default::default() });
+                tree.nodes.push(GpuLightNode::pack(&lights[0], None, [LEAF_BIT | light_index[0], EMPTY], 1));
             }
             _ => {
                 tree.build_node(lights, light_index, &mut items, 0, 0);
@@ -272,16 +358,14 @@ impl LightTree {
         }
         let bounds = items.iter().skip(1).fold(lights[items[0]], |b, &k| b.union(&lights[k]));
         let me = self.nodes.len();
-        self.nodes.push(GpuLightNode { count: items.len() as u32, ..Default::default() });
+        self.nodes.push(GpuLightNode::default());
         let fits = depth + items.len().next_power_of_two().trailing_zeros() < MAX_DEPTH;
         let mid = if fits { split_saoh(lights, items, &bounds) } else { None };
         let mid = mid.unwrap_or_else(|| split_median(lights, items, &bounds));
         let (a, b) = items.split_at_mut(mid);
         let (b0, r0) = self.build_node(lights, index, a, depth + 1, trail);
         let (b1, r1) = self.build_node(lights, index, b, depth + 1, trail | (1u32 << depth));
-        let node = &mut self.nodes[me];
-        (node.c0, node.c1, node.next0, node.next1) = (b0.to_child(), b1.to_child(), r0, r1);
-        node.two_sided = b0.two_sided as u32 | (b1.two_sided as u32) << 1;
+        self.nodes[me] = GpuLightNode::pack(&b0, Some(&b1), [r0, r1], items.len() as u32);
         (bounds, me as u32)
     }
 
@@ -292,7 +376,7 @@ impl LightTree {
 
     /// Every leaf's light-table index, for tests.
     pub fn leaves(&self) -> Vec<u32> {
-        let refs = self.nodes.iter().flat_map(|n| [n.next0, n.next1]);
+        let refs = self.nodes.iter().flat_map(|n| [n.next(0), n.next(1)]);
         refs.filter(|&r| r != EMPTY && r & LEAF_BIT != 0).map(|r| r & !LEAF_BIT).collect()
     }
 
@@ -303,7 +387,7 @@ impl LightTree {
                 return 0;
             }
             let n = &t.nodes[r as usize];
-            1 + walk(t, n.next0).max(walk(t, n.next1))
+            1 + walk(t, n.next(0)).max(walk(t, n.next(1)))
         }
         if self.nodes.is_empty() {
             0
@@ -327,10 +411,10 @@ pub fn pmf(nodes: &[GpuLightNode], mut trail: u32, p: Vec3, n: Vec3) -> f32 {
         let p0 = first_child_probability(node, p, n);
         if trail & 1 == 0 {
             pmf *= p0;
-            r = node.next0;
+            r = node.next(0);
         } else {
             pmf *= 1.0 - p0;
-            r = node.next1;
+            r = node.next(1);
         }
         trail >>= 1;
         if r == EMPTY || r & LEAF_BIT != 0 {
@@ -460,6 +544,54 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Every light below a child lies inside the child's decoded bounds: box, cone (its normals within θo of the
+    /// decoded axis), spread; the compression only widens (scatter lights, and cones of every width).
+    #[test]
+    fn decoded_children_contain_their_lights() {
+        let mut lights = scatter(700);
+        for (i, l) in lights.iter_mut().enumerate().step_by(3) {
+            // Spot-like cones and spreads of varied widths, and some full spheres.
+            l.cos_o = [1.0, 0.9, 0.0, -0.5, -1.0][i % 5];
+            l.cos_e = [0.0, 0.7, -1.0, 0.95][i % 4];
+        }
+        let idx: Vec<u32> = (0..lights.len() as u32).collect();
+        let t = LightTree::build(&lights, &idx);
+        fn below(t: &LightTree, r: u32, out: &mut Vec<u32>) {
+            if r == EMPTY {
+            } else if r & LEAF_BIT != 0 {
+                out.push(r & !LEAF_BIT);
+            } else {
+                let n = &t.nodes[r as usize];
+                below(t, n.next(0), out);
+                below(t, n.next(1), out);
+            }
+        }
+        let mut checked = 0;
+        for node in &t.nodes {
+            for c in 0..2 {
+                let mut ks = vec![];
+                below(&t, node.next(c), &mut ks);
+                let ch = node.child(c);
+                let phi: f64 = ks.iter().map(|&k| lights[k as usize].phi as f64).sum();
+                assert!((ch.phi as f64 - phi).abs() <= 1e-4 * phi, "φ {} against {phi}", ch.phi);
+                let theta_o = (ch.cos_o as f64).clamp(-1.0, 1.0).acos();
+                for &k in &ks {
+                    let l = &lights[k as usize];
+                    assert!(ch.lo.cmple(l.lo).all() && ch.hi.cmpge(l.hi).all(), "box of light {k} outside");
+                    assert!(ch.cos_e <= l.cos_e, "spread of light {k}: {} > {}", ch.cos_e, l.cos_e);
+                    assert_eq!(node.two_sided(c), node.two_sided(c) || l.two_sided);
+                    if ch.cos_o > -1.0 {
+                        let a = ch.axis.as_dvec3().angle_between(l.axis.as_dvec3());
+                        let spread = (l.cos_o as f64).clamp(-1.0, 1.0).acos();
+                        assert!(a + spread <= theta_o, "cone of light {k}: {a} + {spread} > {theta_o}");
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 700 * 5, "{checked} containments checked");
     }
 
     #[test]

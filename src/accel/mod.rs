@@ -4,4 +4,5 @@
 pub mod bvh;
 pub mod convex_solids;
 pub mod light_tree;
+pub mod quantise;
 pub mod wide_bvh;

@@ -2,6 +2,7 @@
 //! Nothing here knows about scenes, estimators or pipelines.
 
 pub mod context;
+pub mod octahedral;
 pub mod timer;
 pub mod types;
 
