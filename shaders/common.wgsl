@@ -260,7 +260,8 @@ struct FrameParams {
     offset_scale: f32,
     /// Candidates per light sample under `--light-select ris`.
     ris_candidates: u32,
-    _pad1: u32,
+    /// Workgroup row j of the dispatch renders tile row (j · stride) mod rows (src/render/tile_order.rs).
+    tile_row_stride: u32,
     _pad2: u32,
 }
 

@@ -109,11 +109,16 @@ fn accumulate(a: ptr<function, Accum>, bad: ptr<function, u32>, v: vec3<f32>) {
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32,
+               @builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid3: vec3<u32>,
+               @builtin(num_workgroups) groups: vec3<u32>) {
     bvh_set_lane(lid);
-    // The dispatch covers rows [row_offset, row_offset + row_count) of the film.
-    let px = vec2<u32>(gid.x, gid.y + params.row_offset);
-    if (px.x >= params.width || gid.y >= params.row_count || px.y >= params.height) { return; }
+    // The dispatch covers rows [row_offset, row_offset + row_count) of the film; its workgroup rows take tile rows
+    // in a spread order, so that each of lavapipe's threads (a static run of workgroups each) gets a fair share of
+    // the image (src/render/tile_order.rs).
+    let row = 8u * ((wg.y * max(params.tile_row_stride, 1u)) % groups.y) + lid3.y;
+    let px = vec2<u32>(gid.x, row + params.row_offset);
+    if (px.x >= params.width || row >= params.row_count || px.y >= params.height) { return; }
     let pixel = px.y * params.width + px.x;
     let n = min(params.samples_per_dispatch, 65536u);
     let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);

@@ -135,7 +135,7 @@ fn shared_structs_match() {
             row_count,
             offset_scale,
             ris_candidates,
-            _pad1,
+            tile_row_stride,
             _pad2
         ]
     );

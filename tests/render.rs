@@ -174,9 +174,12 @@ fn same_seed_same_bits_other_seed_other_bits() {
 fn sample_counts_and_variance_are_consistent() {
     let ctx = gpu();
     let scene = scene("cornell-box");
-    let film = render(&ctx, &scene, &Settings { mode: Mode::Path, ..small(16, 16) }, 20);
+    // 9 tile rows, the last one partial: workgroup rows take tile rows in a spread order (render::tile_order),
+    // and every pixel must still be rendered exactly once per sample.
+    let film = render(&ctx, &scene, &Settings { mode: Mode::Path, ..small(20, 70) }, 20);
     assert_eq!(film.spp(), 20);
-    assert!(film.count.iter().all(|&c| c == 20), "every pixel must hold 20 samples");
+    let missed: Vec<usize> = (0..film.count.len()).filter(|&i| film.count[i] != 20).collect();
+    assert!(missed.is_empty(), "{} pixels without 20 samples, the first {:?}", missed.len(), missed.first());
     assert!(film.m2.iter().flatten().all(|&m| m >= 0.0 && m.is_finite()));
 }
 

@@ -223,7 +223,8 @@ pub struct GpuFrameParams {
     pub offset_scale: f32,
     /// Candidates per light sample under resampled importance sampling.
     pub ris_candidates: u32,
-    pub _pad1: u32,
+    /// Workgroup row j of the dispatch renders tile row (j · stride) mod rows (`render::tile_order`).
+    pub tile_row_stride: u32,
     pub _pad2: u32,
 }
 

@@ -19,5 +19,6 @@ pub mod scene_data;
 pub mod settings;
 pub mod shaders;
 pub mod shading_data;
+pub mod tile_order;
 
 pub use renderer::*;

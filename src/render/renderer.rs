@@ -13,6 +13,7 @@ use crate::render::pipeline_cache::PipelineCache;
 pub use crate::render::settings::RR_DEPTH;
 use crate::render::settings::{Mode, Settings};
 use crate::render::shaders;
+use crate::render::tile_order::tile_row_stride;
 use crate::scene::Camera;
 use std::time::Instant;
 
@@ -521,7 +522,7 @@ impl Renderer {
             row_count: s.height,
             offset_scale: self.offset_scale,
             ris_candidates: s.ris_candidates,
-            _pad1: 0,
+            tile_row_stride: tile_row_stride(s.height.div_ceil(8)),
             _pad2: 0,
         }
     }
@@ -578,7 +579,8 @@ impl Renderer {
         row_count: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let p = GpuFrameParams { row_offset, row_count, ..self.frame_params(spp) };
+        let tile_row_stride = tile_row_stride(row_count.div_ceil(8));
+        let p = GpuFrameParams { row_offset, row_count, tile_row_stride, ..self.frame_params(spp) };
         self.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&p));
         let mut pass = enc
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("render"), timestamp_writes: timestamps });
