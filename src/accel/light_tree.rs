@@ -25,7 +25,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use crate::accel::quantise::{quantise, scale_exponent};
+use crate::accel::quantise::{decode_frame, quantise, scale_exponent};
 use crate::gpu::octahedral::{oct_decode, oct_encode};
 
 /// In a child reference (`GpuLightNode::next`): the child is a leaf and the low bits are its light-table index.
@@ -148,8 +148,7 @@ impl GpuLightNode {
 
     /// Child c's bounds, decoded as the shader decodes them.
     pub fn child(&self, c: usize) -> LightChild {
-        let o = Vec3::new(f32::from_bits(self.head[0]), f32::from_bits(self.head[1]), f32::from_bits(self.head[2]));
-        let s = Vec3::from_array([0, 1, 2].map(|k| f32::from_bits(((self.head[3] >> (8 * k)) & 0xff) << 23)));
+        let (o, s) = decode_frame(&self.head);
         let byte = |i: usize| ((self.boxes[i / 4] >> (8 * (i % 4))) & 0xff) as f32;
         let q = |first: usize| Vec3::new(byte(first), byte(first + 1), byte(first + 2));
         let spread = self.spread_next[c];

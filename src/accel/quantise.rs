@@ -3,9 +3,19 @@
 //! a byte), so `p + s·q` rounds once and an fma gives the same bits: the CPU decodes exactly as the shaders do.
 //! The wide BVH's child boxes (`accel::wide_bvh`) and the light tree's (`accel::light_tree`) use it.
 
+use glam::Vec3;
+
 /// f32 `p + s·q`, as the shader decodes a box edge.
 pub fn decode(p: f32, s: f32, q: u32) -> f32 {
     p + s * q as f32
+}
+
+/// A quantisation frame stored in four words: the origin's f32 bits in xyz and the three biased exponents in bytes
+/// 0–2 of w (the wide BVH's and the light tree's node heads). Returns the origin `p` and the per-axis scale `s`.
+pub fn decode_frame(head: &[u32; 4]) -> (Vec3, Vec3) {
+    let p = Vec3::new(f32::from_bits(head[0]), f32::from_bits(head[1]), f32::from_bits(head[2]));
+    let e = |k: u32| f32::from_bits(((head[3] >> (8 * k)) & 0xff) << 23);
+    (p, Vec3::new(e(0), e(1), e(2)))
 }
 
 /// The biased exponent of the smallest power-of-two scale with `p + 255·s ≥ hi` in f32.

@@ -26,7 +26,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use crate::accel::bvh::{Aabb, Bvh, GpuBvhNode, BVH_STACK_SIZE, EMPTY_CHILD, MAX_LEAF_PRIMS};
-use crate::accel::quantise::{quantise, scale_exponent};
+use crate::accel::quantise::{decode_frame, quantise, scale_exponent};
 
 /// One 8-wide node (WGSL `WideNode`, same field names); see the module docs.
 #[repr(C)]
@@ -63,9 +63,7 @@ pub enum WideChild {
 impl GpuWideNode {
     /// The origin `p` and the per-axis scale `s`.
     pub fn frame(&self) -> (Vec3, Vec3) {
-        let p = Vec3::new(f32::from_bits(self.head[0]), f32::from_bits(self.head[1]), f32::from_bits(self.head[2]));
-        let e = |k: u32| f32::from_bits(((self.head[3] >> (8 * k)) & 0xff) << 23);
-        (p, Vec3::new(e(0), e(1), e(2)))
+        decode_frame(&self.head)
     }
 
     fn byte(words: &[u32], i: usize) -> u32 {
