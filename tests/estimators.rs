@@ -103,8 +103,7 @@ fn cfg(strategy: Strategy) -> Config {
 
 /// One device context for the whole file (tests run on parallel threads and share it).
 fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(gpu)
+    gpu()
 }
 
 struct Bench {

@@ -157,17 +157,28 @@ fn furnace_shortfall_is_direct_modes_missing_bounce() {
     assert!((p - 1.0).abs() < 4.0 * sp + 1e-6, "path {p} ± {sp}: light is lost");
 }
 
+/// Also the device's pipeline memo (`GpuContext::pipelines`): renderers of one scene and settings share one build,
+/// the seed is not compiled in, and another baked scene gets its own pipeline (its primitives are in the source).
 #[test]
 fn same_seed_same_bits_other_seed_other_bits() {
-    let ctx = gpu();
+    // A context of its own, so that no other test's pipelines are counted.
+    let ctx = mislab::gpu::GpuContext::new().expect("a Vulkan adapter");
     let scene = scene("veach-mis");
     let s = small(48, 48);
     let a = render(&ctx, &scene, &s, 8);
+    assert_eq!(ctx.pipelines.len(), 1);
     let b = render(&ctx, &scene, &s, 8);
+    assert_eq!(ctx.pipelines.len(), 1, "a second renderer of the same pipeline must not build it again");
     let bits = |f: &mislab::render::film::Film| f.mean.iter().flat_map(|c| c.map(f32::to_bits)).collect::<Vec<_>>();
     assert_eq!(bits(&a), bits(&b), "the same seed and settings must give the same image bit for bit");
-    let c = render(&ctx, &scene, &Settings { seed: 7, ..s }, 8);
+    let c = render(&ctx, &scene, &Settings { seed: 7, ..s.clone() }, 8);
     assert_ne!(bits(&a), bits(&c), "a different seed must change the image");
+    assert_eq!(ctx.pipelines.len(), 1, "the seed is a run-time parameter");
+    let mut moved = scene.clone();
+    moved.spheres[0].radius *= 1.5;
+    let d = render(&ctx, &moved, &s, 8);
+    assert_eq!(ctx.pipelines.len(), 2, "another baked scene needs its own pipeline");
+    assert_ne!(bits(&a), bits(&d), "a pipeline of the other scene was reused");
 }
 
 #[test]

@@ -258,7 +258,7 @@ enum SceneId {
 
 /// The probe pipelines (built once: lavapipe compiles for seconds) and the test scenes, in `SceneId` order.
 struct Harness {
-    ctx: GpuContext,
+    ctx: &'static GpuContext,
     pipelines: ScenePipelines,
     scenes: Vec<BoundScene>,
 }
@@ -271,7 +271,7 @@ fn harness() -> &'static Harness {
 impl Harness {
     fn new() -> Harness {
         let ctx = common::gpu();
-        let pipelines = ScenePipelines::new(&ctx, &probe_source(), &["probe_sample", "probe_pdf"]).unwrap();
+        let pipelines = ScenePipelines::new(ctx, &probe_source(), &["probe_sample", "probe_pdf"]).unwrap();
         let scenes =
             [lights_scene(), env_scene(pixel_map()), env_scene(map_3x2()), env_scene(hdr_map()), many_lights_scene()]
                 .into_iter()

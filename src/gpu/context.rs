@@ -93,6 +93,37 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Whether timestamp queries work inside compute passes.
     pub timestamps: bool,
+    /// Compute pipelines built on this device, shared by everything that renders on it (`PipelineMemo`).
+    pub pipelines: PipelineMemo,
+}
+
+/// Compute pipelines built on one device, by a fingerprint their builder computes from everything that makes
+/// them differ (source, entry point, constants, layout). lavapipe compiles a render pipeline for seconds, so two
+/// renderers of equal pipelines on one device (a bench's configurations, a test binary's renders, the stress
+/// suite's cases) build it once.
+#[derive(Clone, Default)]
+pub struct PipelineMemo(std::sync::Arc<std::sync::Mutex<std::collections::HashMap<u64, wgpu::ComputePipeline>>>);
+
+impl PipelineMemo {
+    /// The pipeline with `fingerprint`, if one was built on this device.
+    pub fn get(&self, fingerprint: u64) -> Option<wgpu::ComputePipeline> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).get(&fingerprint).cloned()
+    }
+
+    /// Remembers `pipeline` under `fingerprint`.
+    pub fn insert(&self, fingerprint: u64, pipeline: &wgpu::ComputePipeline) {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).insert(fingerprint, pipeline.clone());
+    }
+
+    /// How many pipelines are remembered.
+    pub fn len(&self) -> usize {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).len()
+    }
+
+    /// Whether none is.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 fn summary(a: &wgpu::Adapter) -> AdapterSummary {
@@ -193,7 +224,7 @@ impl GpuContext {
         }))
         .map_err(|source| GpuError::RequestDevice { adapter: info.name.clone(), source })?;
         let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        Ok(GpuContext { instance, adapter, device, queue, info, timestamps })
+        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, pipelines: PipelineMemo::default() })
     }
 
     /// The features and limits we ask for: everything the adapter offers that we use.

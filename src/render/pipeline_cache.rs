@@ -26,19 +26,6 @@ impl PipelineCache {
         self.map.insert(key, pipeline);
     }
 
-    /// The pipeline for `key`, built by `build` the first time it is asked for.
-    pub fn get_or_build<E>(
-        &mut self,
-        key: PipelineKey,
-        build: impl FnOnce() -> Result<wgpu::ComputePipeline, E>,
-    ) -> Result<&wgpu::ComputePipeline, E> {
-        if !self.map.contains_key(&key) {
-            let p = build()?;
-            self.map.insert(key, p);
-        }
-        Ok(&self.map[&key])
-    }
-
     /// Forgets the pipelines for which `keep` is false.
     pub fn retain(&mut self, mut keep: impl FnMut(&PipelineKey) -> bool) {
         self.map.retain(|k, _| keep(k));

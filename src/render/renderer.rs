@@ -3,7 +3,7 @@
 
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::types::*;
-use crate::gpu::{GpuContext, GpuError};
+use crate::gpu::{GpuContext, GpuError, PipelineMemo};
 use crate::render::bindings;
 pub use crate::render::error::RenderError;
 use crate::render::features::{Features, PipelineKey};
@@ -100,6 +100,8 @@ pub struct Renderer {
     queue: wgpu::Queue,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: PipelineCache,
+    /// The device's pipelines (`GpuContext::pipelines`): a pipeline another renderer built is not built again.
+    device_pipelines: PipelineMemo,
     /// The scene's features (what a specialised pipeline compiles in).
     features: Features,
     /// Whether pipelines are specialised to the settings (headless) or read them at run time (viewer).
@@ -238,6 +240,7 @@ impl Renderer {
             queue: ctx.queue.clone(),
             pipeline_layout,
             pipelines: PipelineCache::default(),
+            device_pipelines: ctx.pipelines.clone(),
             features: Features::of(d),
             specialize: true,
             warmed: None,
@@ -319,16 +322,37 @@ impl Renderer {
         }
     }
 
-    /// Builds (or finds in the cache) the pipeline for the current settings.
+    /// Builds (or finds in this renderer's cache, then in the device's) the pipeline for the current settings.
     pub fn prepare(&mut self) -> Result<(), RenderError> {
         let key = self.key();
-        let (device, layout) = (&self.device, &self.pipeline_layout);
+        if self.pipelines.contains(&key) {
+            return Ok(());
+        }
         let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
-        self.pipelines
-            .get_or_build(key, || {
-                shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
-            })
-            .map_err(RenderError::Pipeline)?;
+        // Every render pipeline has the same layout (bindings::SCENE and FRAME): the source and the key tell them apart.
+        let fingerprint = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            ("render_main", source, key).hash(&mut h);
+            h.finish()
+        };
+        let pipeline = match self.device_pipelines.get(fingerprint) {
+            Some(p) => p,
+            None => {
+                let p = shaders::compute_pipeline(
+                    &self.device,
+                    "render",
+                    source,
+                    "render_main",
+                    &key.constants(),
+                    Some(&self.pipeline_layout),
+                )
+                .map_err(RenderError::Pipeline)?;
+                self.device_pipelines.insert(fingerprint, &p);
+                p
+            }
+        };
+        self.pipelines.insert(key, pipeline);
         Ok(())
     }
 

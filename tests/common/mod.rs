@@ -8,10 +8,14 @@ use mislab::render::Renderer;
 use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{self, LoadOptions, Scene};
 
-/// The GPU context, or a panic that says how to get one.
-pub fn gpu() -> GpuContext {
-    GpuContext::new().unwrap_or_else(|e| {
-        panic!("GPU tests need a Vulkan adapter and found none ({e}). On Debian/Ubuntu without a GPU: apt-get install mesa-vulkan-drivers")
+/// The GPU context every test of this binary shares (renderers on one context share their compiled pipelines,
+/// which take lavapipe seconds each), or a panic that says how to get one.
+pub fn gpu() -> &'static GpuContext {
+    static CTX: std::sync::OnceLock<GpuContext> = std::sync::OnceLock::new();
+    CTX.get_or_init(|| {
+        GpuContext::new().unwrap_or_else(|e| {
+            panic!("GPU tests need a Vulkan adapter and found none ({e}). On Debian/Ubuntu without a GPU: apt-get install mesa-vulkan-drivers")
+        })
     })
 }
 

@@ -8,7 +8,6 @@ mod cases;
 pub use cases::{cases, polygon_irradiance};
 
 use crate::gpu::GpuContext;
-use crate::render::features::PipelineKey;
 use crate::render::film::Film;
 use crate::render::settings::Settings;
 use crate::render::Renderer;
@@ -16,7 +15,7 @@ use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::Scene;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{mpsc, Mutex};
+use std::sync::mpsc;
 use std::time::Instant;
 
 /// What a case must show besides zero NaN/Inf samples.
@@ -80,7 +79,7 @@ pub struct Outcome {
     pub seconds: f64,
 }
 
-/// Renders every case (on one thread per core, sharing compiled pipelines between them) and checks it. `filter` keeps the cases whose
+/// Renders every case (on one thread per core; cases with equal pipelines share one build) and checks it. `filter` keeps the cases whose
 /// name contains it (twins are always run). `progress` is called after each case.
 pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Outcome)) -> Result<Vec<Outcome>, String> {
     let all = cases()?;
@@ -99,18 +98,17 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
     // Nearly all of the suite's time is the driver compiling each case's pipeline (a baked scene is its own
     // shader; lavapipe compiles on one thread), so cases render on one worker per core. They are judged in
     // list order, as their results arrive, because a `SameAs` case compares with its twin's mean.
-    let pipelines: Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>> = Mutex::new(HashMap::new());
     let next = AtomicUsize::new(0);
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(wanted.len().max(1));
     let (tx, rx) = mpsc::channel::<(usize, Result<Rendered, String>)>();
     std::thread::scope(|scope| {
         for _ in 0..workers {
             let tx = tx.clone();
-            let (wanted, pipelines, next) = (&wanted, &pipelines, &next);
+            let (wanted, next) = (&wanted, &next);
             scope.spawn(move || loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(c) = wanted.get(i) else { break };
-                let r = render_case(ctx, c, pipelines);
+                let r = render_case(ctx, c);
                 let failed = r.is_err();
                 if tx.send((i, r)).is_err() || failed {
                     // The lead thread stopped listening (it reports the first error), or this worker's case failed:
@@ -148,22 +146,12 @@ struct Rendered {
     seconds: f64,
 }
 
-fn render_case(
-    ctx: &GpuContext,
-    c: &Case,
-    pipelines: &Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>,
-) -> Result<Rendered, String> {
+fn render_case(ctx: &GpuContext, c: &Case) -> Result<Rendered, String> {
     let data = SceneData::build(&c.scene);
     let gs = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", c.name))?;
     let mut r = Renderer::new_unprepared(ctx, &gs, c.scene.camera.clone(), c.settings.clone())?;
-    for (k, p) in pipelines.lock().unwrap_or_else(|e| e.into_inner()).iter() {
-        r.insert_pipeline(*k, p.clone());
-    }
+    // Cases with equal pipelines share one build (the device's `GpuContext::pipelines`).
     r.prepare()?;
-    let key = r.key();
-    if let Some(p) = r.pipeline(&key) {
-        pipelines.lock().unwrap_or_else(|e| e.into_inner()).insert(key, p.clone());
-    }
     r.warm_up(ctx).map_err(|e| e.to_string())?;
     r.set_dispatch_spp(c.dispatch_spp);
     let t = Instant::now();
