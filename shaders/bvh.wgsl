@@ -218,12 +218,23 @@ fn tri_position(k: u32) -> vec3<f32> {
 }
 
 /// Vertex k of `tri_verts` as words (position bits, corner record index). In a scene whose vertices exceed one
-/// binding, those past the first binding's length are in `tri_verts_hi` (src/render/gpu_scene.rs split_vertices).
+/// binding, those past the first binding's length continue in `tri_verts_hi`, then `tri_verts_hi2` and
+/// `tri_verts_hi3` (src/render/gpu_scene.rs split_vertices; an unused part is one zero vertex, never reached).
 fn tri_vertex_words(k: u32) -> vec4<u32> {
     if HAS_GEOMETRY_SPLIT {
-        let n = arrayLength(&tri_verts);
-        if k >= n {
-            return tri_verts_hi[k - n];
+        let n0 = arrayLength(&tri_verts);
+        if k >= n0 {
+            let k1 = k - n0;
+            let n1 = arrayLength(&tri_verts_hi);
+            if k1 < n1 {
+                return tri_verts_hi[k1];
+            }
+            let k2 = k1 - n1;
+            let n2 = arrayLength(&tri_verts_hi2);
+            if k2 < n2 {
+                return tri_verts_hi2[k2];
+            }
+            return tri_verts_hi3[k2 - n2];
         }
     }
     return tri_verts[k];

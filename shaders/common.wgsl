@@ -305,8 +305,8 @@ override HAS_CHECKERBOARD: bool = true;
 /// Texels over two bindings (src/render/gpu_scene.rs split_texels): a TextureInfo offset with TEXEL_HI set
 /// counts into tex_texels_hi. False: that read is compiled out.
 override HAS_TEXEL_SPLIT: bool = true;
-/// Vertices over two bindings (src/render/gpu_scene.rs split_vertices): vertex k past tri_verts' length is in
-/// tri_verts_hi. False: that read is compiled out.
+/// Vertices over two to four bindings (src/render/gpu_scene.rs split_vertices): vertex k past tri_verts' length is
+/// in tri_verts_hi, tri_verts_hi2 or tri_verts_hi3. False: those reads are compiled out.
 override HAS_GEOMETRY_SPLIT: bool = true;
 /// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
 override HAS_SPECULAR: bool = true;

@@ -182,12 +182,12 @@ fn texels_split_over_two_bindings_render_as_one() {
     assert!(msg.contains("texels") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
 }
 
-/// A scene whose vertices exceed the binding limit the renderer believes takes them over two bindings
-/// (gpu_scene::split_vertices, at a triangle boundary) and renders bit for bit as with one; past two bindings it
-/// is a clear error.
+/// A scene whose vertices exceed the binding limit the renderer believes takes them over two, three or four bindings
+/// (gpu_scene::split_vertices, whole triangles per binding) and renders bit for bit as with one; past four bindings
+/// it is a clear error.
 #[test]
-fn vertices_split_over_two_bindings_render_as_one() {
-    use mislab::render::{features::Features, gpu_scene::GpuScene};
+fn vertices_split_over_up_to_four_bindings_render_as_one() {
+    use mislab::render::{bindings::VERTEX_BINDINGS, features::Features, gpu_scene::GpuScene};
     let ctx = common::gpu();
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes/scaling_1k/scaling_1k.toml");
     let scene = common::scene(file);
@@ -196,18 +196,26 @@ fn vertices_split_over_two_bindings_render_as_one() {
     let render = |gs: &GpuScene| two_samples(&ctx, gs, &scene, 32);
     let whole = GpuScene::upload(&ctx, data.clone()).expect("upload");
     assert!(whole.data.tri_verts_hi.is_empty() && !Features::of(&whole.data).geometry_split);
-    // A limit that cuts the vertices in the middle of a triangle's three.
-    let limit = bytes * 3 / 5 + 16;
-    let split = GpuScene::upload_with_limit(&ctx, data.clone(), limit).expect("split upload");
-    let (lo, hi) = (split.data.tri_verts.len(), split.data.tri_verts_hi.len());
-    assert!(lo % 3 == 0 && lo + hi == data.tri_verts.len() && 16 * lo as u64 <= limit && hi > 0, "{lo} + {hi}");
-    assert!(Features::of(&split.data).geometry_split);
-    let (a, b) = (render(&whole), render(&split));
+    let a = render(&whole);
     assert!(a.mean.iter().flatten().any(|&c| c > 0.0), "black render");
-    assert_eq!(a.mean, b.mean, "split vertices render differently");
-    let err = GpuScene::upload_with_limit(&ctx, data, bytes / 3).err().expect("vertices in three bindings' worth");
+    assert_eq!(VERTEX_BINDINGS, 4);
+    // Limits that cut the vertices in the middle of a triangle's three, into 2, 3 and 4 bindings.
+    for (parts, limit) in [(2, bytes * 3 / 5 + 16), (3, bytes * 2 / 5 + 16), (4, bytes * 3 / 10 + 16)] {
+        let split = GpuScene::upload_with_limit(&ctx, data.clone(), limit).expect("split upload");
+        let d = &split.data;
+        let sizes: Vec<usize> = std::iter::once(d.tri_verts.len()).chain(d.tri_verts_hi.iter().map(Vec::len)).collect();
+        assert_eq!(sizes.len(), parts, "{parts} bindings at limit {limit}: {sizes:?}");
+        assert!(sizes.iter().all(|&n| n % 3 == 0 && n > 0 && 16 * n as u64 <= limit), "{sizes:?}");
+        assert_eq!(sizes.iter().sum::<usize>(), data.tri_verts.len());
+        let joined: Vec<[f32; 4]> = d.tri_verts.iter().chain(d.tri_verts_hi.iter().flatten()).copied().collect();
+        assert!(joined == data.tri_verts, "the parts are not the vertices in order");
+        assert!(Features::of(d).geometry_split);
+        assert_eq!(a.mean, render(&split).mean, "vertices over {parts} bindings render differently");
+    }
+    let err = GpuScene::upload_with_limit(&ctx, data, bytes / 5).err().expect("vertices in five bindings' worth");
     let msg = err.to_string();
     assert!(msg.contains("triangle vertices") && msg.contains(&format!("({bytes} bytes)")), "{msg}");
+    assert!(msg.contains("4 bindings"), "{msg}");
 }
 
 const RECORD_PROBE: &str = "

@@ -49,16 +49,15 @@ pub enum GpuError {
         limit >> 20
     )]
     TexelsTooLarge { bytes: u64, second: u64, limit: u64 },
-    /// The triangle vertices exceed two storage bindings (`gpu_scene::split_vertices`).
+    /// The triangle vertices exceed all the storage bindings they may take (`gpu_scene::split_vertices`).
     #[error(
-        "the scene is too large for this device: its triangle vertices need {:.1} MiB ({bytes} bytes); split over \
-         two bindings, the second needs {:.1} MiB ({second} bytes), more than the device's \
-         max_storage_buffer_binding_size of {} MiB ({limit} bytes)",
+        "the scene is too large for this device: its triangle vertices need {:.1} MiB ({bytes} bytes), more than \
+         the {bindings} bindings they may take hold at the device's max_storage_buffer_binding_size of {} MiB \
+         ({limit} bytes) each, whole triangles per binding",
         *bytes as f64 / (1u64 << 20) as f64,
-        *second as f64 / (1u64 << 20) as f64,
         limit >> 20
     )]
-    VerticesTooLarge { bytes: u64, second: u64, limit: u64 },
+    VerticesTooLarge { bytes: u64, bindings: usize, limit: u64 },
 }
 
 /// Layers above that still speak in messages take a GPU error as its message.

@@ -60,16 +60,26 @@ const fn scene(
     Binding { group: 0, binding, name, wgsl_type, access: Access::Read, element_size, label, note: "" }
 }
 
-/// Bindings 0–4 of group 0, [`WIDE_NODES`] and [`TRI_VERTS_HI`] are the geometry (what BVH traversal reads; the
-/// probe kernels bind these alone).
+/// Bindings 0–4 of group 0, [`WIDE_NODES`] and the [`TRI_VERTS_HI`] bindings are the geometry (what BVH traversal
+/// reads; the probe kernels bind these alone).
 pub const GEOMETRY_BINDINGS: u32 = 5;
 /// The binding (and `SCENE` index) of the wide BVH's nodes, a geometry binding added after the shading ones.
 pub const WIDE_NODES: usize = 14;
-/// The binding (and `SCENE` index) of the vertices beyond the first vertex binding, a geometry binding.
+/// The first of the bindings (and `SCENE` indices) of the vertices beyond the first vertex binding: `tri_verts_hi`,
+/// `tri_verts_hi2`, `tri_verts_hi3`, geometry bindings.
 pub const TRI_VERTS_HI: usize = 17;
+/// How many storage bindings the triangle vertices may take (`tri_verts` and the `TRI_VERTS_HI` ones): a scene's
+/// vertices fill 48 bytes per triangle, so on a device whose bindings hold 128 MiB (lavapipe) four bindings take
+/// 11.2M triangles, about where the wide BVH's nodes (8–10 bytes per triangle) reach one binding themselves.
+pub const VERTEX_BINDINGS: usize = 4;
 
 fn is_geometry(i: usize) -> bool {
-    i < GEOMETRY_BINDINGS as usize || i == WIDE_NODES || i == TRI_VERTS_HI
+    i < GEOMETRY_BINDINGS as usize || i == WIDE_NODES || (TRI_VERTS_HI..TRI_VERTS_HI + VERTEX_BINDINGS - 1).contains(&i)
+}
+
+/// The bytes of the k-th part of the vertices beyond the first binding (none where there is no such part).
+fn vertex_part(d: &SceneData, k: usize) -> &[u8] {
+    d.tri_verts_hi.get(k).map_or(&[], |p| bytemuck::cast_slice(p))
 }
 
 /// The geometry bindings of group 0, in binding order.
@@ -83,7 +93,7 @@ pub fn shading() -> impl Iterator<Item = &'static SceneBinding> {
 }
 
 /// Group 0: the scene, in binding order.
-pub const SCENE: [SceneBinding; 18] = [
+pub const SCENE: [SceneBinding; 20] = [
     SceneBinding {
         binding: scene(0, "bvh_nodes", "array<BvhNode>", size_of::<GpuBvhNode>(), "BVH nodes"),
         bytes: |d| bytemuck::cast_slice(&d.bvh_nodes),
@@ -171,7 +181,21 @@ pub const SCENE: [SceneBinding; 18] = [
                    one zero vertex otherwise.",
             ..scene(17, "tri_verts_hi", "array<vec4<u32>>", 16, "triangle vertices beyond the first binding")
         },
-        bytes: |d| bytemuck::cast_slice(&d.tri_verts_hi),
+        bytes: |d| vertex_part(d, 0),
+    },
+    SceneBinding {
+        binding: Binding {
+            note: "Vertices beyond tri_verts_hi when they exceed two bindings; one zero vertex otherwise.",
+            ..scene(18, "tri_verts_hi2", "array<vec4<u32>>", 16, "triangle vertices beyond the second binding")
+        },
+        bytes: |d| vertex_part(d, 1),
+    },
+    SceneBinding {
+        binding: Binding {
+            note: "Vertices beyond tri_verts_hi2 when they exceed three bindings; one zero vertex otherwise.",
+            ..scene(19, "tri_verts_hi3", "array<vec4<u32>>", 16, "triangle vertices beyond the third binding")
+        },
+        bytes: |d| vertex_part(d, 2),
     },
 ];
 

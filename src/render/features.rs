@@ -43,8 +43,8 @@ pub struct Features {
     pub checkerboard: bool,
     /// Texels over two bindings (`gpu_scene::split_texels`): texel reads look at `TEXEL_HI`.
     pub texel_split: bool,
-    /// Vertices over two bindings (`gpu_scene::split_vertices`): vertex reads past `tri_verts` go to
-    /// `tri_verts_hi`.
+    /// Vertices over two to four bindings (`gpu_scene::split_vertices`): vertex reads past `tri_verts` go to
+    /// `tri_verts_hi` and the bindings after it.
     pub geometry_split: bool,
     /// Any material with a GGX lobe.
     pub specular: bool,
@@ -195,7 +195,7 @@ impl Features {
         on("textures", self.textures);
         on("checkerboard textures", self.checkerboard);
         on("texels over two bindings", self.texel_split);
-        on("vertices over two bindings", self.geometry_split);
+        on("vertices over several bindings", self.geometry_split);
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
         on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);

@@ -46,7 +46,7 @@ pub fn memory_per_triangle(data: &SceneData) -> TriangleMemory {
     let tris = data.tri_shading.len().max(1) as f64;
     TriangleMemory {
         bvh: size(&["bvh_nodes", "prim_refs", "wide_nodes"]) / tris,
-        geometry: size(&["tri_verts", "tri_verts_hi"]) / tris,
+        geometry: size(&["tri_verts", "tri_verts_hi", "tri_verts_hi2", "tri_verts_hi3"]) / tris,
         shading: size(&["tri_lights", "shading_verts"]) / tris,
     }
 }
@@ -86,20 +86,22 @@ pub fn split_texels(data: &mut SceneData, limit: u64) -> Result<(), GpuError> {
     Ok(())
 }
 
-/// Vertices beyond one storage binding of `limit` bytes move to the second vertex binding (`tri_verts_hi`), split
-/// at a triangle boundary; the shader reads vertex k from it when k is past `tri_verts`' length (and
-/// `Features::geometry_split` compiles that read in). Past two bindings: `GpuError::VerticesTooLarge`.
+/// Vertices beyond one storage binding of `limit` bytes move to the further vertex bindings (`tri_verts_hi`,
+/// `tri_verts_hi2`, `tri_verts_hi3`), each filled with whole triangles before the next; the shader reads vertex k from
+/// the part its index falls in (and `Features::geometry_split` compiles those reads in). Past
+/// `bindings::VERTEX_BINDINGS` bindings: `GpuError::VerticesTooLarge`.
 pub fn split_vertices(data: &mut SceneData, limit: u64) -> Result<(), GpuError> {
-    let bytes = 16 * (data.tri_verts.len() + data.tri_verts_hi.len()) as u64;
     if 16 * data.tri_verts.len() as u64 <= limit || !data.tri_verts_hi.is_empty() {
         return Ok(());
     }
-    let cut = 3 * (limit / 48) as usize;
-    let second = bytes - 16 * cut as u64;
-    if second > limit {
-        return Err(GpuError::VerticesTooLarge { bytes, second, limit });
+    let bytes = 16 * data.tri_verts.len() as u64;
+    let per_binding = 3 * (limit / 48) as usize;
+    let needed = if per_binding == 0 { usize::MAX } else { data.tri_verts.len().div_ceil(per_binding) };
+    if needed > bindings::VERTEX_BINDINGS {
+        return Err(GpuError::VerticesTooLarge { bytes, bindings: bindings::VERTEX_BINDINGS, limit });
     }
-    data.tri_verts_hi = data.tri_verts.split_off(cut);
+    let rest = data.tri_verts.split_off(per_binding);
+    data.tri_verts_hi = rest.chunks(per_binding).map(<[[f32; 4]]>::to_vec).collect();
     Ok(())
 }
 
@@ -113,7 +115,7 @@ pub fn fit_to_binding_limit(data: &mut SceneData, limit: u64) -> Result<(), GpuE
 
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
-    /// larger than the device's storage-buffer binding limit; texels and vertices may take two bindings
+    /// larger than the device's storage-buffer binding limit; texels may take two bindings, vertices four
     /// (`split_texels`, `split_vertices`).
     pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, GpuError> {
         Self::upload_with_limit(ctx, data, u64::MAX)

@@ -27,9 +27,10 @@ pub struct SceneData {
     /// Three vec4 per triangle: a vertex position in xyz and, in w, the bits of that corner's shading-vertex index
     /// (`tri_shading[i].corners[k]`; `pack_triangle_records`), so triangles need no separate index record.
     pub tri_verts: Vec<[f32; 4]>,
-    /// Vertices moved out of `tri_verts` because they exceed one binding (`gpu_scene::split_vertices`); empty
+    /// Vertices moved out of `tri_verts` because they exceed one binding (`gpu_scene::split_vertices`): one part per
+    /// further vertex binding, at most `bindings::VERTEX_BINDINGS` − 1, each a whole number of triangles; empty
     /// unless split.
-    pub tri_verts_hi: Vec<[f32; 4]>,
+    pub tri_verts_hi: Vec<Vec<[f32; 4]>>,
     /// Per-triangle shading data: shading-vertex indices and light (src/render/shading_data.rs). The CPU's view:
     /// it is uploaded as the w of `tri_verts` and as `tri_lights`.
     pub tri_shading: Vec<GpuTriShading>,

@@ -3,7 +3,7 @@
 //!
 //! Binding convention (the pipeline layout is explicit, so a shader may use any subset of it):
 //! - `@group(0)`: the scene geometry exactly as `geometry_bindings.wgsl` declares it (bindings 0–4: `bvh_nodes`,
-//!   `prim_refs`, `tri_verts`, `spheres`, `quads`, 14: `wide_nodes` and 17: `tri_verts_hi`, all `var<storage, read>`). Present only when the job has a
+//!   `prim_refs`, `tri_verts`, `spheres`, `quads`, 14: `wide_nodes` and 17–19: `tri_verts_hi`…`hi3`, all `var<storage, read>`). Present only when the job has a
 //!   [`GeometryBuffers`]; without one the shader must not declare group 0.
 //! - `@group(1)` ([`PROBE_GROUP`]): `@binding(0)` the output, `var<storage, read_write>`, pre-filled with
 //!   [`PROBE_SENTINEL`] words so unwritten results are recognisable (a NaN as f32); `@binding(1 + k)` the k-th input,
@@ -42,7 +42,7 @@ pub enum ProbeError {
     Gpu(#[from] GpuError),
 }
 
-/// The seven geometry storage buffers of `geometry_bindings.wgsl` (group 0).
+/// The nine geometry storage buffers of `geometry_bindings.wgsl` (group 0).
 pub struct GeometryBuffers {
     pub bvh_nodes: wgpu::Buffer,
     pub prim_refs: wgpu::Buffer,
@@ -51,6 +51,8 @@ pub struct GeometryBuffers {
     pub quads: wgpu::Buffer,
     pub wide_nodes: wgpu::Buffer,
     pub tri_verts_hi: wgpu::Buffer,
+    pub tri_verts_hi2: wgpu::Buffer,
+    pub tri_verts_hi3: wgpu::Buffer,
 }
 
 impl GeometryBuffers {
@@ -67,13 +69,25 @@ impl GeometryBuffers {
             quads: ctx.storage_buffer("quads", quads, none),
             wide_nodes: ctx.storage_buffer("wide_nodes", &bvh.wide, none),
             tri_verts_hi: ctx.storage_buffer::<[f32; 4]>("tri_verts_hi", &[], none),
+            tri_verts_hi2: ctx.storage_buffer::<[f32; 4]>("tri_verts_hi2", &[], none),
+            tri_verts_hi3: ctx.storage_buffer::<[f32; 4]>("tri_verts_hi3", &[], none),
         }
     }
 
     /// In the order of `bindings::geometry()`.
-    fn buffers(&self) -> [&wgpu::Buffer; 7] {
+    fn buffers(&self) -> [&wgpu::Buffer; 9] {
         let s = self;
-        [&s.bvh_nodes, &s.prim_refs, &s.tri_verts, &s.spheres, &s.quads, &s.wide_nodes, &s.tri_verts_hi]
+        [
+            &s.bvh_nodes,
+            &s.prim_refs,
+            &s.tri_verts,
+            &s.spheres,
+            &s.quads,
+            &s.wide_nodes,
+            &s.tri_verts_hi,
+            &s.tri_verts_hi2,
+            &s.tri_verts_hi3,
+        ]
     }
 }
 
