@@ -1,8 +1,10 @@
 //! The render pipelines built so far, by `PipelineKey`: the one cache the renderer and the viewer's engine share
 //! the shape of (building one takes seconds on lavapipe, so nothing is built twice).
 
+use crate::gpu::PipelineMemo;
 use crate::render::features::PipelineKey;
 use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
 
 /// Compute pipelines by key.
 #[derive(Default)]
@@ -24,6 +26,34 @@ impl PipelineCache {
     /// Adds (or replaces) the pipeline for `key`.
     pub fn insert(&mut self, key: PipelineKey, pipeline: wgpu::ComputePipeline) {
         self.map.insert(key, pipeline);
+    }
+
+    /// Makes sure the pipeline for `key` is here: from this cache, else from the device's `memo` (another renderer
+    /// built it: same `source` and key), else built by `build` and remembered in both. Every render pipeline has the
+    /// same layout, so the source and the key tell them apart.
+    pub fn get_or_share<E>(
+        &mut self,
+        key: PipelineKey,
+        source: &str,
+        memo: &PipelineMemo,
+        build: impl FnOnce() -> Result<wgpu::ComputePipeline, E>,
+    ) -> Result<(), E> {
+        if self.map.contains_key(&key) {
+            return Ok(());
+        }
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        ("render_main", source, key).hash(&mut h);
+        let fingerprint = h.finish();
+        let pipeline = match memo.get(fingerprint) {
+            Some(p) => p,
+            None => {
+                let p = build()?;
+                memo.insert(fingerprint, &p);
+                p
+            }
+        };
+        self.map.insert(key, pipeline);
+        Ok(())
     }
 
     /// Forgets the pipelines for which `keep` is false.

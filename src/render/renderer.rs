@@ -325,35 +325,13 @@ impl Renderer {
     /// Builds (or finds in this renderer's cache, then in the device's) the pipeline for the current settings.
     pub fn prepare(&mut self) -> Result<(), RenderError> {
         let key = self.key();
-        if self.pipelines.contains(&key) {
-            return Ok(());
-        }
+        let (device, layout) = (&self.device, &self.pipeline_layout);
         let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
-        // Every render pipeline has the same layout (bindings::SCENE and FRAME): the source and the key tell them apart.
-        let fingerprint = {
-            use std::hash::{Hash, Hasher};
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            ("render_main", source, key).hash(&mut h);
-            h.finish()
-        };
-        let pipeline = match self.device_pipelines.get(fingerprint) {
-            Some(p) => p,
-            None => {
-                let p = shaders::compute_pipeline(
-                    &self.device,
-                    "render",
-                    source,
-                    "render_main",
-                    &key.constants(),
-                    Some(&self.pipeline_layout),
-                )
-                .map_err(RenderError::Pipeline)?;
-                self.device_pipelines.insert(fingerprint, &p);
-                p
-            }
-        };
-        self.pipelines.insert(key, pipeline);
-        Ok(())
+        self.pipelines
+            .get_or_share(key, source, &self.device_pipelines, || {
+                shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
+            })
+            .map_err(RenderError::Pipeline)
     }
 
     /// Switches between specialised and generic pipelines (the viewer runs the generic one while a
