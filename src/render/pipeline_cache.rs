@@ -6,13 +6,20 @@ use crate::render::features::PipelineKey;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 
-/// Compute pipelines by key.
+/// Compute pipelines by key, and the device's memo they are shared through (`get_or_share`; a default cache has a
+/// memo of its own).
 #[derive(Default)]
 pub struct PipelineCache {
     map: HashMap<PipelineKey, wgpu::ComputePipeline>,
+    device: PipelineMemo,
 }
 
 impl PipelineCache {
+    /// An empty cache that shares pipelines through the device's `memo` (`GpuContext::pipelines`).
+    pub fn on_device(memo: &PipelineMemo) -> PipelineCache {
+        PipelineCache { map: HashMap::new(), device: memo.clone() }
+    }
+
     /// The pipeline for `key`, if built.
     pub fn get(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
         self.map.get(key)
@@ -28,14 +35,13 @@ impl PipelineCache {
         self.map.insert(key, pipeline);
     }
 
-    /// Makes sure the pipeline for `key` is here: from this cache, else from the device's `memo` (another renderer
+    /// Makes sure the pipeline for `key` is here: from this cache, else from the device's memo (another renderer
     /// built it: same `source` and key), else built by `build` and remembered in both. Every render pipeline has the
     /// same layout, so the source and the key tell them apart.
     pub fn get_or_share<E>(
         &mut self,
         key: PipelineKey,
         source: &str,
-        memo: &PipelineMemo,
         build: impl FnOnce() -> Result<wgpu::ComputePipeline, E>,
     ) -> Result<(), E> {
         if self.map.contains_key(&key) {
@@ -44,11 +50,11 @@ impl PipelineCache {
         let mut h = std::collections::hash_map::DefaultHasher::new();
         ("render_main", source, key).hash(&mut h);
         let fingerprint = h.finish();
-        let pipeline = match memo.get(fingerprint) {
+        let pipeline = match self.device.get(fingerprint) {
             Some(p) => p,
             None => {
                 let p = build()?;
-                memo.insert(fingerprint, &p);
+                self.device.insert(fingerprint, &p);
                 p
             }
         };

@@ -3,7 +3,7 @@
 
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::types::*;
-use crate::gpu::{GpuContext, GpuError, PipelineMemo};
+use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
 pub use crate::render::error::RenderError;
 use crate::render::features::{Features, PipelineKey};
@@ -99,9 +99,8 @@ pub struct Renderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline_layout: wgpu::PipelineLayout,
+    /// This renderer's pipelines, shared through the device's memo (a pipeline another renderer built is not rebuilt).
     pipelines: PipelineCache,
-    /// The device's pipelines (`GpuContext::pipelines`): a pipeline another renderer built is not built again.
-    device_pipelines: PipelineMemo,
     /// The scene's features (what a specialised pipeline compiles in).
     features: Features,
     /// Whether pipelines are specialised to the settings (headless) or read them at run time (viewer).
@@ -239,8 +238,7 @@ impl Renderer {
             device,
             queue: ctx.queue.clone(),
             pipeline_layout,
-            pipelines: PipelineCache::default(),
-            device_pipelines: ctx.pipelines.clone(),
+            pipelines: PipelineCache::on_device(&ctx.pipelines),
             features: Features::of(d),
             specialize: true,
             warmed: None,
@@ -328,7 +326,7 @@ impl Renderer {
         let (device, layout) = (&self.device, &self.pipeline_layout);
         let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
         self.pipelines
-            .get_or_share(key, source, &self.device_pipelines, || {
+            .get_or_share(key, source, || {
                 shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
             })
             .map_err(RenderError::Pipeline)
