@@ -22,10 +22,12 @@ const BVH_LANES: u32 = 64u;
 // Traversal stacks live in workgroup memory, one BVH_STACK_SIZE slice per invocation: lavapipe lowers
 // dynamic indexing of a private (function-scope) array to chains of selects over every element, and a
 // 64-entry private stack made path tracing 1.7× slower than an 8-entry one; workgroup memory is plain
-// addressed memory (and needs no zero-initialisation per call). 2 × 64 × 64 × 4 B = 32 KiB. An entry is two
-// words: the BVH2 keeps a reference and its entry distance (f32 bits), the wide tree (bvh_wide.wgsl) a group.
-var<workgroup> bvh_stack_node: array<u32, 4096>;
-var<workgroup> bvh_stack_aux: array<u32, 4096>;
+// addressed memory (and needs no zero-initialisation per call). 64 × 64 × 8 B = 32 KiB. An entry is two
+// words in one vec2 — the BVH2 keeps a reference and its entry distance (f32 bits), the wide tree
+// (bvh_wide.wgsl) a group — because Mesa 22's lavapipe runs every workgroup-memory access as a loop over the
+// SIMD lanes, one loop per load or store instruction whatever its width: one vec2 is half the loops of two u32
+// arrays (docs/profile-bvh.md, "The JIT code").
+var<workgroup> bvh_stack: array<vec2<u32>, 4096>;
 /// This invocation's index in its workgroup; entry points that trace call `bvh_set_lane` first.
 var<private> bvh_lane: u32;
 
@@ -274,7 +276,8 @@ fn bvh_pop(base: u32, sp: ptr<function, u32>, t: f32) -> u32 {
         return INVALID;
     }
     *sp -= 1u;
-    return select(INVALID, bvh_stack_node[base + *sp], bitcast<f32>(bvh_stack_aux[base + *sp]) <= t);
+    let e = bvh_stack[base + *sp];
+    return select(INVALID, e.x, bitcast<f32>(e.y) <= t);
 }
 
 /// A leaf primitive's test: its reference and hit (w = 0: a miss, a cut-out point, or `skip`).
@@ -358,8 +361,7 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
                 let near_t = select(tl, tr, right_first);
                 let far_t = select(tr, tl, right_first);
                 if far_t != F32_MAX && sp < BVH_STACK_SIZE {
-                    bvh_stack_node[base + sp] = select(rref, lref, right_first);
-                    bvh_stack_aux[base + sp] = bitcast<u32>(far_t);
+                    bvh_stack[base + sp] = vec2<u32>(select(rref, lref, right_first), bitcast<u32>(far_t));
                     sp += 1u;
                 }
                 next = select(INVALID, select(lref, rref, right_first), near_t != F32_MAX);

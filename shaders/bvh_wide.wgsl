@@ -54,17 +54,16 @@ fn wide_node_hits(r: TraceRay, oct: u32, n: WideNode, t: f32) -> u32 {
 fn wide_push(base: u32, sp: ptr<function, u32>, e: vec2<u32>) {
     // src/accel/wide_bvh.rs keeps 2 · depth ≤ BVH_STACK_SIZE, so this never drops an entry.
     if *sp < BVH_STACK_SIZE {
-        bvh_stack_node[base + *sp] = e.x;
-        bvh_stack_aux[base + *sp] = e.y;
+        bvh_stack[base + *sp] = e;
         *sp += 1u;
     }
 }
 
 /// Closest or any hit in the wide tree: the paper's traversal with node groups and leaf groups. A node group is
 /// (child_base, interior hit bits | imask): the next child is the lowest rank left, and the rest of the group is
-/// pushed before descending. A leaf group is (tri_base, primitive hit bits). As in `bvh_traverse`, a lane that finds
-/// leaf primitives postpones them (pushing a second group) and keeps traversing until every lane of its subgroup has
-/// some; then all test them together, one primitive per iteration. Stack entries carry no distance: a group's
+/// pushed before descending. A leaf group is (tri_base, primitive hit bits). A lane that finds leaf primitives
+/// postpones them and waits until every lane of its SIMD group has some or is done (Aila & Laine 2009's while-while
+/// loop); then all test them together, one primitive per iteration. Stack entries carry no distance: a group's
 /// boxes were tested against the closest hit when its node was loaded, and every primitive test uses the current one.
 fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var hit = Hit(t_max, INVALID, 0.0, 0.0);
@@ -75,15 +74,19 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var g = vec2<u32>(0u, 1u << (24u + oct));
     var tg = vec2<u32>(0u, 0u);
     var sp = 0u;
-    // Every node is loaded at most once and pushes at most two entries: these bound both loops.
+    // Every node is loaded at most once and pushes at most one entry: these bound both loops.
     let bound = 3u * arrayLength(&wide_nodes) + 1u;
     for (var round = 0u; round < bound && ((g.y & WIDE_NODE_BITS) != 0u || tg.y != 0u || sp > 0u); round++) {
-        for (var step = 0u; step < bound && ((g.y & WIDE_NODE_BITS) != 0u || (tg.y == 0u && sp > 0u)); step++) {
+        // A lane steps until it holds a leaf group, then waits for the others: each iteration loads one node, so
+        // a lane finds at most one leaf group per iteration and never has to push one. (Speculating on, as the
+        // BVH2 loop does, gained nothing on the wide tree and cost a second push in every step: lavapipe runs a
+        // store as a loop over the SIMD lanes whether or not a lane stores; docs/profile-bvh.md.)
+        for (var step = 0u; step < bound && tg.y == 0u && ((g.y & WIDE_NODE_BITS) != 0u || sp > 0u); step++) {
             // Pop and step in one iteration: lanes run in lockstep, so an iteration spent only popping idles the
             // lanes that have a node to visit (the BVH2 loop measured the same).
             if (g.y & WIDE_NODE_BITS) == 0u {
                 sp -= 1u;
-                let e = vec2<u32>(bvh_stack_node[base + sp], bvh_stack_aux[base + sp]);
+                let e = bvh_stack[base + sp];
                 if (e.y & WIDE_NODE_BITS) != 0u {
                     g = e;
                 } else {
@@ -101,17 +104,7 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
                 let node = wide_nodes[idx];
                 let hits = wide_node_hits(r, oct, node, hit.t);
                 g = vec2<u32>(node.links.x, (hits & WIDE_NODE_BITS) | (node.head.w >> 24u));
-                let prims = hits & ~WIDE_NODE_BITS;
-                if prims != 0u {
-                    if tg.y == 0u {
-                        tg = vec2<u32>(node.links.y, prims);
-                    } else {
-                        wide_push(base, &sp, vec2<u32>(node.links.y, prims));
-                    }
-                }
-            }
-            if bvh_all_lanes(tg.y != 0u) {
-                break;
+                tg = vec2<u32>(node.links.y, hits & ~WIDE_NODE_BITS);
             }
         }
         // The postponed leaf group's primitives.
