@@ -83,7 +83,8 @@ pub fn validate(source: &str) -> Result<naga::Module, String> {
 const BVH_VOTE_FALLBACK: &str = "return b; // BVH_VOTE";
 
 /// A composed module as `device` compiles it: with subgroup operations (wgpu's `Features::SUBGROUP`, which
-/// `GpuContext` requests where offered) the traversal's vote becomes `subgroupAll`; without them the module is unchanged and each lane votes alone (a plain while-while loop).
+/// `GpuContext` requests where offered) the BVH2 traversal's vote becomes `subgroupAll`; without them the module is
+/// unchanged and each lane votes alone (a plain while-while loop). The wide traversal, the default, has no vote.
 /// The one place a device changes shader text, so every pipeline (render, viewer, probes) gets the same code.
 pub fn for_device(source: &str, features: wgpu::Features) -> std::borrow::Cow<'_, str> {
     let vote_off = std::env::var("MISLAB_BVH_VOTE").is_ok_and(|v| v == "0");
