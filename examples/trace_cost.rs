@@ -48,19 +48,11 @@ fn probe_any(r: Ray) -> u32 {
 }
 ";
 
+/// DamagedHelmet's triangles as mislab loads them (the product's glTF import and scene flattening).
 fn helmet() -> Vec<[Vec3; 3]> {
-    let gltf = gltf::Gltf::open(HELMET).unwrap_or_else(|e| panic!("cannot open {HELMET}: {e}"));
-    let buffers = gltf::import_buffers(&gltf.document, None, gltf.blob.clone()).expect("DamagedHelmet buffers");
-    let mut tris = Vec::new();
-    for mesh in gltf.document.meshes() {
-        for prim in mesh.primitives() {
-            let reader = prim.reader(|b| Some(&buffers[b.index()]));
-            let pos: Vec<Vec3> = reader.read_positions().expect("positions").map(Vec3::from).collect();
-            let idx: Vec<u32> = reader.read_indices().expect("indices").into_u32().collect();
-            tris.extend(idx.chunks_exact(3).map(|t| [pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]));
-        }
-    }
-    tris
+    let scene = mislab::scene::load(HELMET, &mislab::scene::LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let data = mislab::render::scene_data::SceneData::build(&scene);
+    data.tri_verts.chunks_exact(3).map(|t| [0, 1, 2].map(|k| Vec3::from_slice(&t[k][..3]))).collect()
 }
 
 struct Lcg(u64);
