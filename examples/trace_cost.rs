@@ -7,25 +7,15 @@
 use glam::{Vec3, Vec3Swizzles};
 use mislab::accel::bvh;
 use mislab::gpu::GpuContext;
-use mislab::testkit::probe::{GeometryBuffers, Probe};
+use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay, PROBE_RAY_WGSL};
 use std::time::Instant;
 
 const HELMET: &str =
     concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct Ray {
-    o: [f32; 3],
-    t_max: f32,
-    d: [f32; 3],
-    _pad: f32,
-}
-
 const KERNEL: &str = "
 override REPEAT: u32 = 1u;
-struct Ray { o: vec3<f32>, t_max: f32, d: vec3<f32>, _pad: f32 }
-fn probe_closest(r: Ray) -> u32 {
+fn probe_closest(r: ProbeRay) -> u32 {
     var acc = 0u;
     var t_max = r.t_max;
     for (var k = 0u; k < REPEAT; k++) {
@@ -36,7 +26,7 @@ fn probe_closest(r: Ray) -> u32 {
     }
     return acc;
 }
-fn probe_any(r: Ray) -> u32 {
+fn probe_any(r: ProbeRay) -> u32 {
     var acc = 0u;
     var t_max = r.t_max;
     for (var k = 0u; k < REPEAT; k++) {
@@ -64,7 +54,7 @@ impl Lcg {
 }
 
 /// Camera rays of a `side`² image in 8×8 tiles (a workgroup's lanes), looking at the model from +z.
-fn camera_rays(tris: &[[Vec3; 3]], side: u32) -> Vec<Ray> {
+fn camera_rays(tris: &[[Vec3; 3]], side: u32) -> Vec<ProbeRay> {
     let (lo, hi) = bounds(tris);
     let c = (lo + hi) * 0.5;
     let r = (hi - lo).length() * 0.5;
@@ -77,7 +67,7 @@ fn camera_rays(tris: &[[Vec3; 3]], side: u32) -> Vec<Ray> {
                 let u = (x as f32 + 0.5) / side as f32 * 2.0 - 1.0;
                 let v = 1.0 - (y as f32 + 0.5) / side as f32 * 2.0;
                 let d = Vec3::new(u * 0.5, v * 0.5, -1.0).normalize();
-                rays.push(Ray { o: eye.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 });
+                rays.push(ProbeRay { o: eye.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 });
             }
         }
     }
@@ -90,10 +80,10 @@ fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
 
 /// Bounce-like rays: from a random point of a random triangle, cosine-distributed about its normal, in random
 /// order (`sorted`: ordered by the origin's cell on a 64³ grid and the direction's octant, a crude ray sort).
-fn bounce_rays(tris: &[[Vec3; 3]], n: usize, sorted: bool) -> Vec<Ray> {
+fn bounce_rays(tris: &[[Vec3; 3]], n: usize, sorted: bool) -> Vec<ProbeRay> {
     let mut rng = Lcg(7);
     let (lo, hi) = bounds(tris);
-    let mut rays: Vec<(u64, Ray)> = (0..n)
+    let mut rays: Vec<(u64, ProbeRay)> = (0..n)
         .filter_map(|_| {
             let t = tris[(rng.next() * tris.len() as f32) as usize % tris.len()];
             let ng = (t[1] - t[0]).cross(t[2] - t[0]);
@@ -114,7 +104,7 @@ fn bounce_rays(tris: &[[Vec3; 3]], n: usize, sorted: bool) -> Vec<Ray> {
             let cell = ((o - lo) / (hi - lo) * 63.99).as_uvec3();
             let oct = (d.x > 0.0) as u64 | ((d.y > 0.0) as u64) << 1 | ((d.z > 0.0) as u64) << 2;
             let key = oct << 40 | (cell.xzy().x as u64) << 12 | (cell.y as u64) << 6 | cell.z as u64;
-            Some((key, Ray { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 }))
+            Some((key, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 }))
         })
         .collect();
     if sorted {
@@ -123,9 +113,9 @@ fn bounce_rays(tris: &[[Vec3; 3]], n: usize, sorted: bool) -> Vec<Ray> {
     rays.into_iter().map(|r| r.1).collect()
 }
 
-fn seconds(probe: &Probe, source: &str, function: &str, rays: &[Ray], geo: &GeometryBuffers) -> f64 {
+fn seconds(probe: &Probe, source: &str, function: &str, rays: &[ProbeRay], geo: &GeometryBuffers) -> f64 {
     let t = Instant::now();
-    let out: Vec<u32> = probe.map(source, "Ray", "u32", function, rays, Some(geo)).unwrap_or_else(|e| panic!("{e}"));
+    let out: Vec<u32> = probe.map(source, "ProbeRay", "u32", function, rays, Some(geo)).unwrap_or_else(|e| panic!("{e}"));
     std::hint::black_box(out);
     t.elapsed().as_secs_f64()
 }
@@ -139,7 +129,7 @@ fn main() {
     let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
     let library = mislab::render::shaders::compose(
         &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "bvh_wide.wgsl", "baked_geometry.wgsl"],
-        &format!("{no_alpha}{KERNEL}"),
+        &format!("{no_alpha}{PROBE_RAY_WGSL}{KERNEL}"),
     )
     .replace("override WIDE_BVH: bool = false;", "override WIDE_BVH: bool = true;");
     let probe = Probe::new(&ctx);

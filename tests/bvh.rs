@@ -6,7 +6,7 @@ use mislab::accel::bvh::reference::{self, Ray, RefHit, Scene};
 use mislab::accel::bvh::{self, Bvh, EMPTY_CHILD};
 use mislab::gpu::types::{make_prim, GpuQuad, GpuSphere, INVALID, PRIM_SPHERE, PRIM_TRIANGLE};
 use mislab::gpu::GpuContext;
-use mislab::testkit::probe::{GeometryBuffers, Probe};
+use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay, PROBE_RAY_WGSL};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -24,15 +24,6 @@ use common::gpu;
 
 // ---------------------------------------------------------------------------------------------------------------
 // Probe kernels
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct ProbeRay {
-    o: [f32; 3],
-    t_max: f32,
-    d: [f32; 3],
-    _pad: f32,
-}
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
@@ -70,7 +61,6 @@ struct ProbeSpawnOut {
 }
 
 const PROBE_WGSL: &str = "
-struct ProbeRay { o: vec3<f32>, t_max: f32, d: vec3<f32>, _pad: f32 }
 struct ProbeTrace { t: f32, prim: u32, b1: f32, b2: f32, any: u32, _p0: u32, _p1: u32, _p2: u32 }
 fn probe_trace(r: ProbeRay) -> ProbeTrace {
     let h = trace_closest(r.o, r.d, r.t_max);
@@ -91,7 +81,7 @@ fn probe_source() -> String {
     let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
     mislab::render::shaders::compose(
         &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "bvh_wide.wgsl", "baked_geometry.wgsl"],
-        &format!("{no_alpha}{PROBE_WGSL}"),
+        &format!("{no_alpha}{PROBE_RAY_WGSL}{PROBE_WGSL}"),
     )
 }
 

@@ -28,6 +28,19 @@ pub const PROBE_SENTINEL: u32 = 0xffff_dead;
 /// Workgroup size of [`map_kernel`] kernels.
 pub const MAP_WORKGROUP_SIZE: u32 = 64;
 
+/// A ray as tracing probe kernels take it (WGSL [`PROBE_RAY_WGSL`]): origin, the hit distance limit, direction.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ProbeRay {
+    pub o: [f32; 3],
+    pub t_max: f32,
+    pub d: [f32; 3],
+    pub _pad: f32,
+}
+
+/// The WGSL declaration of [`ProbeRay`] (32 bytes, the same field order).
+pub const PROBE_RAY_WGSL: &str = "struct ProbeRay { o: vec3<f32>, t_max: f32, d: vec3<f32>, _pad: f32 }\n";
+
 /// Why a probe failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ProbeError {
