@@ -115,7 +115,8 @@ fn bounce_rays(tris: &[[Vec3; 3]], n: usize, sorted: bool) -> Vec<ProbeRay> {
 
 fn seconds(probe: &Probe, source: &str, function: &str, rays: &[ProbeRay], geo: &GeometryBuffers) -> f64 {
     let t = Instant::now();
-    let out: Vec<u32> = probe.map(source, "ProbeRay", "u32", function, rays, Some(geo)).unwrap_or_else(|e| panic!("{e}"));
+    let out: Vec<u32> =
+        probe.map(source, "ProbeRay", "u32", function, rays, Some(geo)).unwrap_or_else(|e| panic!("{e}"));
     std::hint::black_box(out);
     t.elapsed().as_secs_f64()
 }
