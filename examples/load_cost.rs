@@ -5,7 +5,9 @@
 //! - `uniform`: every lane of a workgroup follows the same chain (what a ray per subgroup, with lanes over a node's
 //!   children, would do for its node loads);
 //! - `consecutive`: a uniform chain whose lanes read eight neighbouring entries (lanes over a node's children);
-//! - `alu`: the per-lane chain's arithmetic with the loads replaced by a hash (the loop's own cost).
+//! - `alu`: the per-lane chain's arithmetic with the loads replaced by a hash (the loop's own cost);
+//! - `per_lane_u64`: `per_lane` reading 32 bytes a load (vec4<u64>, on a device with 64-bit integers) from the same
+//!   table: what shaders/geometry_loads_int64.wgsl turns on (a load's cost is per lane, not per byte).
 //! `cargo run --release --example load_cost [LOG2_ENTRIES]` prints ns per load per lane for each, best of three dispatches.
 
 use mislab::gpu::GpuContext;
@@ -78,6 +80,32 @@ fn alu(@builtin(global_invocation_id) g: vec3<u32>) {
 }
 "#;
 
+/// `per_lane` over the same bytes as 32-byte elements (the u64 halves folded back to words).
+const KERNEL_U64: &str = r#"
+@group(1) @binding(0) var<storage, read_write> out: array<u32>;
+@group(1) @binding(1) var<storage, read> table: array<vec4<u64>>;
+override MASK: u32 = 0xfffffu;
+const STEPS: u32 = 512u;
+
+fn hash(x: u32) -> u32 {
+    var h = x * 747796405u + 2891336453u;
+    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+    return (h >> 22u) ^ h;
+}
+
+@compute @workgroup_size(64)
+fn per_lane_u64(@builtin(global_invocation_id) g: vec3<u32>) {
+    var a = hash(g.x);
+    var acc = 0u;
+    for (var i = 0u; i < STEPS; i++) {
+        let w = table[(a & MASK) >> 1u];
+        acc += u32(w.y) + u32(w.z) + u32(w.w >> 32u);
+        a = u32(w.x) ^ i;
+    }
+    out[g.x] = acc;
+}
+"#;
+
 fn main() {
     // The table: 2^k entries of 16 bytes (k = the first argument, default 20: 16 MiB; 14: 256 KiB fits a cache).
     let k: u32 = std::env::args().nth(1).map_or(20, |a| a.parse().expect("log2 of the table size"));
@@ -96,13 +124,18 @@ fn main() {
     let table: &[u8] = bytemuck::cast_slice(&words);
     let lanes = (WORKGROUPS * WG_SIZE) as f64;
     let probe = Probe::new(&ctx);
-    for entry in ["per_lane", "uniform", "consecutive", "alu"] {
+    let int64 = ctx.device.features().contains(wgpu::Features::SHADER_INT64);
+    if !int64 {
+        println!("(no 64-bit integers on this device: per_lane_u64 not run)");
+    }
+    let entries = ["per_lane", "uniform", "consecutive", "alu", "per_lane_u64"];
+    for entry in entries.into_iter().filter(|e| int64 || *e != "per_lane_u64") {
         let loads = if entry == "consecutive" { 2.0 } else { 1.0 } * STEPS as f64;
         let mut best = f64::MAX;
         for _ in 0..3 {
             let t0 = std::time::Instant::now();
             let job = ProbeJob {
-                source: KERNELS,
+                source: if entry == "per_lane_u64" { KERNEL_U64 } else { KERNELS },
                 entry,
                 inputs: &[table],
                 output_bytes: 4 * lanes as u64,

@@ -129,7 +129,14 @@ fn main() {
     let geo = GeometryBuffers::new(&ctx, &wide, &tris, &[], &[]);
     let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
     let library = mislab::render::shaders::compose(
-        &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "bvh_wide.wgsl", "baked_geometry.wgsl"],
+        &[
+            "common.wgsl",
+            "geometry_bindings.wgsl",
+            "bvh.wgsl",
+            "bvh_wide.wgsl",
+            "geometry_loads.wgsl",
+            "baked_geometry.wgsl",
+        ],
         &format!("{no_alpha}{PROBE_RAY_WGSL}{KERNEL}"),
     )
     .replace("override WIDE_BVH: bool = false;", "override WIDE_BVH: bool = true;");

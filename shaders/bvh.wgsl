@@ -192,10 +192,7 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
     switch prim_kind(prim) {
         case PRIM_TRIANGLE: {
             if (!HAS_TRIANGLES) { return vec4<f32>(0.0); }
-            let v0 = tri_position(3u * i);
-            let v1 = tri_position(3u * i + 1u);
-            let v2 = tri_position(3u * i + 2u);
-            return intersect_triangle(r, v0, v1, v2, t_max);
+            return intersect_triangle_at(r, i, t_max);
         }
         case PRIM_SPHERE: {
             if (!HAS_SPHERES) { return vec4<f32>(0.0); }
@@ -224,7 +221,7 @@ fn tri_position(k: u32) -> vec3<f32> {
 /// `tri_verts_hi3` (src/render/gpu_scene.rs split_vertices; an unused part is one zero vertex, never reached).
 fn tri_vertex_words(k: u32) -> vec4<u32> {
     if HAS_GEOMETRY_SPLIT {
-        let n0 = arrayLength(&tri_verts);
+        let n0 = tri_verts_len();
         if k >= n0 {
             let k1 = k - n0;
             let n1 = arrayLength(&tri_verts_hi);
@@ -239,7 +236,30 @@ fn tri_vertex_words(k: u32) -> vec4<u32> {
             return tri_verts_hi3[k2 - n2];
         }
     }
-    return tri_verts[k];
+    return tri_verts_words(k);
+}
+
+/// A triangle's three vertices as words (position bits, corner record index), as `tri_words`
+/// (geometry_loads.wgsl) reads them in one go.
+struct TriWords {
+    a: vec4<u32>,
+    b: vec4<u32>,
+    c: vec4<u32>,
+}
+
+/// Triangle i's vertices: from `tri_verts` in as few loads as the device allows, or vertex by vertex where the
+/// scene's vertices take further bindings (HAS_GEOMETRY_SPLIT; a triangle never straddles two).
+fn triangle_words(i: u32) -> TriWords {
+    if HAS_GEOMETRY_SPLIT {
+        return TriWords(tri_vertex_words(3u * i), tri_vertex_words(3u * i + 1u), tri_vertex_words(3u * i + 2u));
+    }
+    return tri_words(i);
+}
+
+/// Intersects triangle i (its vertices' position bits as floats only here: w holds integer records).
+fn intersect_triangle_at(r: TraceRay, i: u32, t_max: f32) -> vec4<f32> {
+    let w = triangle_words(i);
+    return intersect_triangle(r, bitcast<vec3<f32>>(w.a.xyz), bitcast<vec3<f32>>(w.b.xyz), bitcast<vec3<f32>>(w.c.xyz), t_max);
 }
 
 /// A child reference in one word, as the traversal stack and the leaf queue hold it: an interior node's index
@@ -297,7 +317,7 @@ fn bvh_leaf_test(r: TraceRay, j: u32, t: f32, skip: u32) -> LeafHit {
     if HAS_TRIANGLES && !HAS_SPHERES && !HAS_QUADS {
         prim = j; // PRIM_TRIANGLE << 30 | index
         if prim != skip {
-            h = intersect_triangle(r, tri_position(3u * prim), tri_position(3u * prim + 1u), tri_position(3u * prim + 2u), t);
+            h = intersect_triangle_at(r, prim, t);
         }
     } else {
         // A triangle-only scene uploads no references (src/render/scene_data.rs IDENTITY_PRIM_REFS): INVALID = j.

@@ -75,7 +75,7 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var tg = vec2<u32>(0u, 0u);
     var sp = 0u;
     // Every node is loaded at most once and pushes at most one entry: these bound both loops.
-    let bound = 3u * arrayLength(&wide_nodes) + 1u;
+    let bound = 3u * wide_node_count() + 1u;
     for (var round = 0u; round < bound && ((g.y & WIDE_NODE_BITS) != 0u || tg.y != 0u || sp > 0u); round++) {
         // A lane steps until it holds a leaf group, then waits for the others: each iteration loads one node, so
         // a lane finds at most one leaf group per iteration and never has to push one. (Speculating on, as the
@@ -101,7 +101,7 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
                 if (g.y & WIDE_NODE_BITS) != 0u {
                     wide_push(base, &sp, g);
                 }
-                let node = wide_nodes[idx];
+                let node = wide_node(idx);
                 let hits = wide_node_hits(r, oct, node, hit.t);
                 g = vec2<u32>(node.links.x, (hits & WIDE_NODE_BITS) | (node.head.w >> 24u));
                 tg = vec2<u32>(node.links.y, hits & ~WIDE_NODE_BITS);

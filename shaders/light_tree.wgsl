@@ -2,10 +2,10 @@
 // give the importance), and the pmf of a given light from a shading point, for MIS. Called by select_light /
 // light_pmf in lights.wgsl.
 //
-// The lights with a position come first in the light table, `light_tree[0].boxes.w` of them; the infinite ones
+// The lights with a position come first in the light table, `light_node(0u).boxes.w` of them; the infinite ones
 // (directional, environment) follow. Each infinite light is chosen with the probability of the whole tree:
 // 1 / (infinite + 1), or 1 / infinite without a tree. Each node holds both children's bounds, so a step down is
-// one node load (four vec4).
+// one node load (four vec4, or two 32-byte loads: light_tree_loads.wgsl).
 
 /// In a LightNode's next words (spread_next.zw): the child is a leaf, the low bits its light index (light_tree::LEAF_BIT).
 const LIGHT_LEAF_BIT: u32 = 0x80000000u;
@@ -100,7 +100,7 @@ struct TreeSplit {
     infinite: u32,
 }
 fn tree_split() -> TreeSplit {
-    let bounded = light_tree[0].boxes.w;
+    let bounded = light_node(0u).boxes.w;
     let infinite = params.num_lights - bounded;
     let choices = infinite + select(0u, 1u, bounded > 0u);
     return TreeSplit(select(0.0, 1.0 / f32(choices), bounded > 0u), bounded, infinite);
@@ -120,7 +120,7 @@ fn tree_select_light(u_in: f32, p: vec3<f32>, n: vec3<f32>) -> LightPick {
     var pmf = t.p_tree;
     var next = 0u;
     for (var depth = 0u; depth < 32u; depth += 1u) {
-        let node = light_tree[next];
+        let node = light_node(next);
         let p0 = tree_first_child_probability(node, p, n);
         if (u < p0) {
             u = min(u / p0, ONE_MINUS_EPSILON);
@@ -143,7 +143,7 @@ fn tree_light_pmf(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     var pmf = t.p_tree;
     var next = 0u;
     for (var depth = 0u; depth < 32u; depth += 1u) {
-        let node = light_tree[next];
+        let node = light_node(next);
         let p0 = tree_first_child_probability(node, p, n);
         if ((trail & 1u) == 0u) {
             pmf *= p0;

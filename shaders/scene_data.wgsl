@@ -6,7 +6,7 @@
 // short select chain little.
 
 /// A triangle's three positions and its corners' shading-vertex indices (the w of each vertex: one set of loads
-/// gives both; `tri_verts` is read as u32 words, see bvh.wgsl `tri_position`).
+/// gives both; `tri_verts` is read as u32 words, see bvh.wgsl `triangle_words`).
 struct TriPositions {
     v0: vec3<f32>,
     v1: vec3<f32>,
@@ -15,10 +15,8 @@ struct TriPositions {
 }
 
 fn scene_tri_positions(i: u32) -> TriPositions {
-    let a = tri_vertex_words(3u * i);
-    let b = tri_vertex_words(3u * i + 1u);
-    let c = tri_vertex_words(3u * i + 2u);
-    return TriPositions(bitcast<vec3<f32>>(a.xyz), bitcast<vec3<f32>>(b.xyz), bitcast<vec3<f32>>(c.xyz), vec3<u32>(a.w, b.w, c.w));
+    let w = triangle_words(i);
+    return TriPositions(bitcast<vec3<f32>>(w.a.xyz), bitcast<vec3<f32>>(w.b.xyz), bitcast<vec3<f32>>(w.c.xyz), vec3<u32>(w.a.w, w.b.w, w.c.w));
 }
 /// Corner k's shading-vertex index alone (one load).
 fn scene_tri_corner(i: u32, k: u32) -> u32 { return tri_vertex_words(3u * i + k).w; }

@@ -80,7 +80,14 @@ fn probe_source() -> String {
     // Geometry only: no textures, so no cut-outs (alpha.wgsl needs the shading bindings).
     let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
     mislab::render::shaders::compose(
-        &["common.wgsl", "geometry_bindings.wgsl", "bvh.wgsl", "bvh_wide.wgsl", "baked_geometry.wgsl"],
+        &[
+            "common.wgsl",
+            "geometry_bindings.wgsl",
+            "bvh.wgsl",
+            "bvh_wide.wgsl",
+            "geometry_loads.wgsl",
+            "baked_geometry.wgsl",
+        ],
         &format!("{no_alpha}{PROBE_RAY_WGSL}{PROBE_WGSL}"),
     )
 }
@@ -1172,6 +1179,47 @@ fn gpu_wide_traversal_matches_reference_and_bvh2() {
         let refs: Vec<_> = rays.iter().map(|r| reference::closest(&g.scene(), &ray64(r))).collect();
         let s = compare(g, &rays, &gpu, &refs, EDGE_MARGIN);
         check(&format!("wide, single primitive {k}"), &s, 1e-3);
+    }
+}
+
+/// The two ways of reading vertices and wide nodes (shaders/geometry_loads.wgsl, 16 bytes a load, and its `_int64`
+/// twin, 32 bytes a load, which a device with 64-bit integers gets) find the same hits, bit for bit: on odd and even
+/// counts of triangles and nodes (the twin's odd elements start mid-element), and on no geometry at all. The
+/// portable file is kept by changing its first line, so `shaders::for_device` no longer recognises it.
+#[test]
+fn gpu_16_and_32_byte_loads_find_the_same_hits() {
+    let ctx = gpu();
+    let wide = wide_source();
+    let int64 = ctx.device.features().contains(wgpu::Features::SHADER_INT64);
+    let as_compiled = mislab::render::shaders::for_device(&wide, ctx.device.features());
+    assert_eq!(as_compiled.contains("var<storage, read> wide_nodes: array<vec4<u64>>"), int64);
+    let loads = mislab::render::shaders::file("geometry_loads.wgsl");
+    let kept = loads.replacen("// geometry_loads.wgsl", "// geometry_loads.wgsl (kept)", 1);
+    let portable = wide.replace(loads.as_ref(), &kept);
+    assert!(!mislab::render::shaders::for_device(&portable, ctx.device.features()).contains("vec4<u64>"));
+    let odd = Geometry { tris: soup(9).tris[..1001].to_vec(), spheres: vec![], quads: vec![] };
+    let one = Geometry { tris: vec![[Vec3::new(-1.0, -1.0, 0.2), Vec3::X, Vec3::Y]], spheres: vec![], quads: vec![] };
+    let none = Geometry { tris: vec![], spheres: vec![], quads: vec![] };
+    for (name, g, seed) in [
+        ("soup", soup(8), 10),
+        ("DamagedHelmet", helmet(), 11),
+        ("odd soup", odd, 12),
+        ("one", one, 13),
+        ("none", none, 14),
+    ] {
+        let b = g.build_wide();
+        let rays = make_rays(&g, 20_000, seed);
+        let a = gpu_trace_source(&ctx, &g, &b, &rays, &wide);
+        let p = gpu_trace_source(&ctx, &g, &b, &rays, &portable);
+        let bits = |t: &ProbeTrace| (t.prim, t.t.to_bits(), t.b1.to_bits(), t.b2.to_bits(), t.any);
+        let differ = a.iter().zip(&p).filter(|(x, y)| bits(x) != bits(y)).count();
+        eprintln!(
+            "{name}: {} triangles, {} wide nodes, {} rays, {differ} differ",
+            g.tris.len(),
+            b.wide.len(),
+            rays.len()
+        );
+        assert_eq!(differ, 0, "{name}: 16- and 32-byte loads disagree on {differ} rays");
     }
 }
 

@@ -101,10 +101,8 @@ fn probe_bsdf() -> BsdfParams {
 fn probe_light_normal(i: u32, y: vec3<f32>) -> vec3<f32> {
     let l = lights[i];
     if (l.kind == LIGHT_TRIANGLE) {
-        let v0 = bitcast<vec3<f32>>(tri_verts[3u * l.prim].xyz);
-        let v1 = bitcast<vec3<f32>>(tri_verts[3u * l.prim + 1u].xyz);
-        let v2 = bitcast<vec3<f32>>(tri_verts[3u * l.prim + 2u].xyz);
-        return normalize(cross(v1 - v0, v2 - v0));
+        let t = scene_tri_positions(l.prim);
+        return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
     }
     if (l.kind == LIGHT_QUAD) { let q = quads[l.prim]; return normalize(cross(q.edge_u, q.edge_v)); }
     if (l.kind == LIGHT_SPHERE) { return normalize(y - spheres[l.prim].center); }

@@ -127,3 +127,56 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         }
     }
 }
+
+/// On a device with 64-bit integers the render module reads vertices, wide nodes and light-tree nodes 32 bytes a
+/// load: each 16-byte load file gives way to its `_int64` twin and exactly the bindings those read become
+/// `array<vec4<u64>>`; the result validates. Without the feature the module is unchanged. No other code reads those
+/// bindings (so redeclaring them cannot break a reader the twins do not replace).
+#[test]
+fn int64_devices_get_32_byte_loads_and_others_the_module_unchanged() {
+    use mislab::render::bindings::{self, READ_32_BYTES_AT_A_TIME, WGSL_32_BYTE_ELEMENTS};
+    use mislab::render::shaders::{file, for_device};
+    let src = mislab::render::render_source();
+    assert_eq!(for_device(&src, wgpu::Features::empty()), src.as_str());
+    let wide = for_device(&src, wgpu::Features::SHADER_INT64);
+    for f in ["geometry_loads", "light_tree_loads"] {
+        assert!(!wide.contains(file(&format!("{f}.wgsl")).as_ref()), "{f}.wgsl still in the int64 module");
+        assert!(wide.contains(file(&format!("{f}_int64.wgsl")).as_ref()), "{f}_int64.wgsl missing");
+    }
+    let declared_wide: Vec<&str> = bindings::all()
+        .filter(|b| {
+            wide.contains(&bindings::wgsl_declaration(&bindings::Binding { wgsl_type: WGSL_32_BYTE_ELEMENTS, ..*b }))
+        })
+        .map(|b| b.name)
+        .collect();
+    let mut expected: Vec<&str> = READ_32_BYTES_AT_A_TIME.iter().map(|(n, _)| *n).collect();
+    expected.sort_by_key(|n| bindings::all().position(|b| b.name == *n));
+    assert_eq!(declared_wide, expected);
+    if let Err(e) = mislab::render::shaders::validate(&wide) {
+        panic!("int64 render module:\n{e}");
+    }
+    // Only the load files index these bindings.
+    for (name, _) in READ_32_BYTES_AT_A_TIME {
+        for (f, text) in mislab::render::shaders::FILES {
+            if !f.contains("_loads") {
+                assert!(
+                    !text.contains(&format!("{name}[")),
+                    "{f} reads {name} directly: read it through its load file"
+                );
+            }
+        }
+    }
+}
+
+/// Padding for 32-byte reads: whole elements (at least one) for those bindings, nothing for the others.
+#[test]
+fn only_32_byte_read_bindings_are_padded() {
+    use mislab::render::bindings::pad_for_32_byte_reads;
+    for (len, want) in [(0, 32), (16, 32), (32, 32), (48, 64), (80, 96), (160, 160)] {
+        assert_eq!(pad_for_32_byte_reads("wide_nodes", &vec![7u8; len]).len(), want, "{len} bytes");
+        assert_eq!(pad_for_32_byte_reads("tri_lights", &vec![7u8; len]).len(), len);
+    }
+    let p = pad_for_32_byte_reads("tri_verts", &[1u8; 48]);
+    assert_eq!(&p[..48], &[1u8; 48]);
+    assert!(p[48..].iter().all(|&b| b == 0));
+}

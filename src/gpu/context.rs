@@ -230,10 +230,12 @@ impl GpuContext {
     pub fn wanted(adapter: &wgpu::Adapter) -> (wgpu::Features, wgpu::Limits) {
         let available = adapter.features();
         // SUBGROUP: the traversal's speculative vote (shaders/bvh.wgsl bvh_all_lanes, src/render/shaders.rs for_device).
+        // SHADER_INT64: 32-byte loads of vertices and nodes (shaders/geometry_loads_int64.wgsl, same place).
         let features = available
             & (wgpu::Features::TIMESTAMP_QUERY
                 | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
-                | wgpu::Features::SUBGROUP);
+                | wgpu::Features::SUBGROUP
+                | wgpu::Features::SHADER_INT64);
         (features, adapter.limits())
     }
 

@@ -250,6 +250,32 @@ pub fn all() -> impl Iterator<Item = Binding> {
     SCENE.iter().map(|s| s.binding).chain(FRAME)
 }
 
+/// The bindings a device with 64-bit integers reads 32 bytes a load, as `array<vec4<u64>>` (src/render/shaders.rs
+/// `for_device`, shaders/*_int64.wgsl), with the file whose accessors read each: their buffers are padded to whole
+/// 32-byte elements ([`pad_for_32_byte_reads`]).
+pub const READ_32_BYTES_AT_A_TIME: [(&str, &str); 3] = [
+    ("tri_verts", "geometry_loads.wgsl"),
+    ("wide_nodes", "geometry_loads.wgsl"),
+    ("light_tree", "light_tree_loads.wgsl"),
+];
+
+/// The WGSL type of the bindings in [`READ_32_BYTES_AT_A_TIME`] on a device with 64-bit integers.
+pub const WGSL_32_BYTE_ELEMENTS: &str = "array<vec4<u64>>";
+
+/// `bytes` of binding `name` as uploaded: zero-padded to whole 32-byte elements (at least one) where the binding is in
+/// [`READ_32_BYTES_AT_A_TIME`] (the last triangle or node may end in the middle of one), unchanged otherwise
+/// (elsewhere a padding word could be read: `tri_lights` is read with a clamped index).
+pub fn pad_for_32_byte_reads<'a>(name: &str, bytes: &'a [u8]) -> std::borrow::Cow<'a, [u8]> {
+    let padded = bytes.len().next_multiple_of(32).max(32);
+    if READ_32_BYTES_AT_A_TIME.iter().any(|(n, _)| *n == name) && bytes.len() != padded {
+        let mut v = bytes.to_vec();
+        v.resize(padded, 0);
+        v.into()
+    } else {
+        bytes.into()
+    }
+}
+
 /// The WGSL declaration of `b`, with its note as a comment above it.
 pub fn wgsl_declaration(b: &Binding) -> String {
     let var = match b.access {

@@ -95,7 +95,9 @@ pub fn split_vertices(data: &mut SceneData, limit: u64) -> Result<(), GpuError> 
         return Ok(());
     }
     let bytes = 16 * data.tri_verts.len() as u64;
-    let per_binding = 3 * (limit / 48) as usize;
+    // Whole triangles, and an even number of vertices: a device with 64-bit integers reads two vertices a load
+    // (shaders/geometry_loads_int64.wgsl), so the first binding must end at the end of one of its elements.
+    let per_binding = 6 * (limit / 96) as usize;
     let needed = if per_binding == 0 { usize::MAX } else { data.tri_verts.len().div_ceil(per_binding) };
     if needed > bindings::VERTEX_BINDINGS {
         return Err(GpuError::VerticesTooLarge { bytes, bindings: bindings::VERTEX_BINDINGS, limit });
@@ -128,7 +130,10 @@ impl GpuScene {
         fit_to_binding_limit(&mut data, limit)?;
         let buffers = bindings::SCENE
             .iter()
-            .map(|b| ctx.storage_buffer_bytes(b.binding.name, (b.bytes)(&data), b.binding.element_size))
+            .map(|b| {
+                let bytes = bindings::pad_for_32_byte_reads(b.binding.name, (b.bytes)(&data));
+                ctx.storage_buffer_bytes(b.binding.name, &bytes, b.binding.element_size)
+            })
             .collect();
         Ok(GpuScene { data, buffers })
     }

@@ -6,6 +6,8 @@ pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
     ("bvh_wide.wgsl", include_str!("../../shaders/bvh_wide.wgsl")),
+    ("geometry_loads.wgsl", include_str!("../../shaders/geometry_loads.wgsl")),
+    ("geometry_loads_int64.wgsl", include_str!("../../shaders/geometry_loads_int64.wgsl")),
     ("baked_geometry.wgsl", include_str!("../../shaders/baked_geometry.wgsl")),
     ("scene_data.wgsl", include_str!("../../shaders/scene_data.wgsl")),
     ("specialize.wgsl", include_str!("../../shaders/specialize.wgsl")),
@@ -21,6 +23,8 @@ pub const FILES: &[(&str, &str)] = &[
     ("alpha.wgsl", include_str!("../../shaders/alpha.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
     ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
+    ("light_tree_loads.wgsl", include_str!("../../shaders/light_tree_loads.wgsl")),
+    ("light_tree_loads_int64.wgsl", include_str!("../../shaders/light_tree_loads_int64.wgsl")),
     ("mis.wgsl", include_str!("../../shaders/mis.wgsl")),
     ("estimators.wgsl", include_str!("../../shaders/estimators.wgsl")),
     ("integrator.wgsl", include_str!("../../shaders/integrator.wgsl")),
@@ -82,18 +86,49 @@ pub fn validate(source: &str) -> Result<naga::Module, String> {
 /// The line of `bvh_all_lanes` (shaders/bvh.wgsl) that a device with subgroup operations replaces.
 const BVH_VOTE_FALLBACK: &str = "return b; // BVH_VOTE";
 
-/// A composed module as `device` compiles it: with subgroup operations (wgpu's `Features::SUBGROUP`, which
-/// `GpuContext` requests where offered) the BVH2 traversal's vote becomes `subgroupAll`; without them the module is
-/// unchanged and each lane votes alone (a plain while-while loop). The wide traversal, the default, has no vote.
-/// The one place a device changes shader text, so every pipeline (render, viewer, probes) gets the same code.
+/// A composed module as `device` compiles it. The one place a device changes shader text, so every pipeline
+/// (render, viewer, probes) gets the same code:
+/// - with subgroup operations (wgpu's `Features::SUBGROUP`, which `GpuContext` requests where offered) the BVH2
+///   traversal's vote becomes `subgroupAll`; without them each lane votes alone (a plain while-while loop). The
+///   wide traversal, the default, has no vote. `MISLAB_BVH_VOTE=0` keeps the lone vote (for A/B runs).
+/// - with 64-bit integers (`Features::SHADER_INT64`, requested where offered) each file of 16-byte loads in
+///   [`bindings::READ_32_BYTES_AT_A_TIME`] gives way to its `_int64` twin, and the bindings it reads are declared
+///   `array<vec4<u64>>`: 32 bytes a load. `MISLAB_INT64=0` keeps the 16-byte loads (for A/B runs).
 pub fn for_device(source: &str, features: wgpu::Features) -> std::borrow::Cow<'_, str> {
+    let mut out = std::borrow::Cow::Borrowed(source);
     let vote_off = std::env::var("MISLAB_BVH_VOTE").is_ok_and(|v| v == "0");
     if features.contains(wgpu::Features::SUBGROUP) && source.contains(BVH_VOTE_FALLBACK) && !vote_off {
         // (naga 30 takes subgroup builtins without WGSL's `enable subgroups;`, which it rejects as unimplemented.)
-        source.replace(BVH_VOTE_FALLBACK, "return subgroupAll(b);").into()
-    } else {
-        source.into()
+        out = out.replace(BVH_VOTE_FALLBACK, "return subgroupAll(b);").into();
     }
+    let int64_off = std::env::var("MISLAB_INT64").is_ok_and(|v| v == "0");
+    if features.contains(wgpu::Features::SHADER_INT64) && !int64_off {
+        out = with_32_byte_loads(&out).map_or(out, Into::into);
+    }
+    out
+}
+
+/// `source` with its 16-byte load files swapped for their `_int64` twins and the bindings they read redeclared
+/// (see [`for_device`]), or None where it has none of those files. A binding is redeclared only with the file that
+/// reads it, and only these files read those bindings.
+pub fn with_32_byte_loads(source: &str) -> Option<String> {
+    use crate::render::bindings;
+    let mut out = source.to_string();
+    let mut changed = false;
+    for portable in ["geometry_loads.wgsl", "light_tree_loads.wgsl"] {
+        let text = file(portable);
+        if !out.contains(text.as_ref()) {
+            continue;
+        }
+        let twin = file(&portable.replace(".wgsl", "_int64.wgsl"));
+        out = out.replace(text.as_ref(), &twin);
+        for b in bindings::all().filter(|b| bindings::READ_32_BYTES_AT_A_TIME.contains(&(b.name, portable))) {
+            let wide = bindings::Binding { wgsl_type: bindings::WGSL_32_BYTE_ELEMENTS, ..b };
+            out = out.replace(&bindings::wgsl_declaration(&b), &bindings::wgsl_declaration(&wide));
+        }
+        changed = true;
+    }
+    changed.then_some(out)
 }
 
 /// Builds a compute pipeline from a composed module (validated by naga first so errors are readable).

@@ -17,6 +17,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use crate::accel::bvh::Bvh;
+use crate::accel::wide_bvh::GpuWideNode;
 use crate::gpu::types::{GpuQuad, GpuSphere};
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
@@ -74,13 +75,17 @@ impl GeometryBuffers {
     pub fn new(ctx: &GpuContext, bvh: &Bvh, tris: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad]) -> Self {
         let verts: Vec<[f32; 4]> = tris.iter().flat_map(|t| t.iter().map(|v| [v.x, v.y, v.z, 0.0])).collect();
         let none = wgpu::BufferUsages::empty();
+        // As the scene upload does: padded where a device may read 32 bytes at a time.
+        let padded = |name: &str, bytes: &[u8], element_size: usize| {
+            ctx.storage_buffer_bytes(name, &bindings::pad_for_32_byte_reads(name, bytes), element_size)
+        };
         GeometryBuffers {
             bvh_nodes: ctx.storage_buffer("bvh_nodes", &bvh.nodes, none),
             prim_refs: ctx.storage_buffer("prim_refs", &bvh.prim_refs, none),
-            tri_verts: ctx.storage_buffer("tri_verts", &verts, none),
+            tri_verts: padded("tri_verts", bytemuck::cast_slice(&verts), 16),
             spheres: ctx.storage_buffer("spheres", spheres, none),
             quads: ctx.storage_buffer("quads", quads, none),
-            wide_nodes: ctx.storage_buffer("wide_nodes", &bvh.wide, none),
+            wide_nodes: padded("wide_nodes", bytemuck::cast_slice(&bvh.wide), size_of::<GpuWideNode>()),
             tri_verts_hi: ctx.storage_buffer::<[f32; 4]>("tri_verts_hi", &[], none),
             tri_verts_hi2: ctx.storage_buffer::<[f32; 4]>("tri_verts_hi2", &[], none),
             tri_verts_hi3: ctx.storage_buffer::<[f32; 4]>("tri_verts_hi3", &[], none),
