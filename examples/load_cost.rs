@@ -80,19 +80,9 @@ fn alu(@builtin(global_invocation_id) g: vec3<u32>) {
 }
 "#;
 
-/// `per_lane` over the same bytes as 32-byte elements (the u64 halves folded back to words).
+/// `per_lane` over the same bytes as 32-byte elements (the u64 halves folded back to words), after KERNELS' header
+/// with the table declared `array<vec4<u64>>` (`u64_source`).
 const KERNEL_U64: &str = r#"
-@group(1) @binding(0) var<storage, read_write> out: array<u32>;
-@group(1) @binding(1) var<storage, read> table: array<vec4<u64>>;
-override MASK: u32 = 0xfffffu;
-const STEPS: u32 = 512u;
-
-fn hash(x: u32) -> u32 {
-    var h = x * 747796405u + 2891336453u;
-    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
-    return (h >> 22u) ^ h;
-}
-
 @compute @workgroup_size(64)
 fn per_lane_u64(@builtin(global_invocation_id) g: vec3<u32>) {
     var a = hash(g.x);
@@ -128,6 +118,8 @@ fn main() {
     if !int64 {
         println!("(no 64-bit integers on this device: per_lane_u64 not run)");
     }
+    let header = &KERNELS[..KERNELS.find("@compute").expect("KERNELS has entry points")];
+    let u64_source = header.replace("array<vec4<u32>>", "array<vec4<u64>>") + KERNEL_U64;
     let entries = ["per_lane", "uniform", "consecutive", "alu", "per_lane_u64"];
     for entry in entries.into_iter().filter(|e| int64 || *e != "per_lane_u64") {
         let loads = if entry == "consecutive" { 2.0 } else { 1.0 } * STEPS as f64;
@@ -135,7 +127,7 @@ fn main() {
         for _ in 0..3 {
             let t0 = std::time::Instant::now();
             let job = ProbeJob {
-                source: if entry == "per_lane_u64" { KERNEL_U64 } else { KERNELS },
+                source: if entry == "per_lane_u64" { &u64_source } else { KERNELS },
                 entry,
                 inputs: &[table],
                 output_bytes: 4 * lanes as u64,

@@ -7,7 +7,7 @@
 use glam::{Vec3, Vec3Swizzles};
 use mislab::accel::bvh;
 use mislab::gpu::GpuContext;
-use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay, PROBE_RAY_WGSL};
+use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay};
 use std::time::Instant;
 
 const HELMET: &str =
@@ -127,19 +127,8 @@ fn main() {
     let tris = helmet();
     let wide = bvh::build_wide(&tris, &[], &[]);
     let geo = GeometryBuffers::new(&ctx, &wide, &tris, &[], &[]);
-    let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
-    let library = mislab::render::shaders::compose(
-        &[
-            "common.wgsl",
-            "geometry_bindings.wgsl",
-            "bvh.wgsl",
-            "bvh_wide.wgsl",
-            "geometry_loads.wgsl",
-            "baked_geometry.wgsl",
-        ],
-        &format!("{no_alpha}{PROBE_RAY_WGSL}{KERNEL}"),
-    )
-    .replace("override WIDE_BVH: bool = false;", "override WIDE_BVH: bool = true;");
+    let library = mislab::testkit::probe::trace_module(KERNEL)
+        .replace("override WIDE_BVH: bool = false;", "override WIDE_BVH: bool = true;");
     let probe = Probe::new(&ctx);
     let side = ((n as f64).sqrt() as u32 / 8 * 8).max(8);
     let sets = [

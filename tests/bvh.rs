@@ -6,7 +6,7 @@ use mislab::accel::bvh::reference::{self, Ray, RefHit, Scene};
 use mislab::accel::bvh::{self, Bvh, EMPTY_CHILD};
 use mislab::gpu::types::{make_prim, GpuQuad, GpuSphere, INVALID, PRIM_SPHERE, PRIM_TRIANGLE};
 use mislab::gpu::GpuContext;
-use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay, PROBE_RAY_WGSL};
+use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -77,19 +77,7 @@ fn probe_spawn(s: ProbeSpawn) -> ProbeSpawnOut {
 ";
 
 fn probe_source() -> String {
-    // Geometry only: no textures, so no cut-outs (alpha.wgsl needs the shading bindings).
-    let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
-    mislab::render::shaders::compose(
-        &[
-            "common.wgsl",
-            "geometry_bindings.wgsl",
-            "bvh.wgsl",
-            "bvh_wide.wgsl",
-            "geometry_loads.wgsl",
-            "baked_geometry.wgsl",
-        ],
-        &format!("{no_alpha}{PROBE_RAY_WGSL}{PROBE_WGSL}"),
-    )
+    mislab::testkit::probe::trace_module(PROBE_WGSL)
 }
 
 struct Geometry {

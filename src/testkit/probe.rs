@@ -42,6 +42,23 @@ pub struct ProbeRay {
 /// The WGSL declaration of [`ProbeRay`] (32 bytes, the same field order).
 pub const PROBE_RAY_WGSL: &str = "struct ProbeRay { o: vec3<f32>, t_max: f32, d: vec3<f32>, _pad: f32 }\n";
 
+/// A tracing probe's module: the files traversal needs and `kernels` after [`PROBE_RAY_WGSL`]. Geometry only: no
+/// textures, so no cut-outs (alpha.wgsl needs the shading bindings).
+pub fn trace_module(kernels: &str) -> String {
+    let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
+    crate::render::shaders::compose(
+        &[
+            "common.wgsl",
+            "geometry_bindings.wgsl",
+            "bvh.wgsl",
+            "bvh_wide.wgsl",
+            "geometry_loads.wgsl",
+            "baked_geometry.wgsl",
+        ],
+        &format!("{no_alpha}{PROBE_RAY_WGSL}{kernels}"),
+    )
+}
+
 /// Why a probe failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ProbeError {
