@@ -251,8 +251,8 @@ pub fn all() -> impl Iterator<Item = Binding> {
 }
 
 /// The bindings a device with 64-bit integers reads 32 bytes a load, as `array<vec4<u64>>` (src/render/shaders.rs
-/// `for_device`, shaders/*_int64.wgsl), with the file whose accessors read each: their buffers are padded to whole
-/// 32-byte elements ([`pad_for_32_byte_reads`]).
+/// `for_device`, shaders/*_int64.wgsl), with the file whose accessors read each (grouped by file): their buffers are
+/// padded to whole 32-byte elements ([`pad_for_32_byte_reads`]).
 pub const READ_32_BYTES_AT_A_TIME: [(&str, &str); 3] = [
     ("tri_verts", "geometry_loads.wgsl"),
     ("wide_nodes", "geometry_loads.wgsl"),

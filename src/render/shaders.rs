@@ -115,7 +115,9 @@ pub fn with_32_byte_loads(source: &str) -> Option<String> {
     use crate::render::bindings;
     let mut out = source.to_string();
     let mut changed = false;
-    for portable in ["geometry_loads.wgsl", "light_tree_loads.wgsl"] {
+    let mut files: Vec<&str> = bindings::READ_32_BYTES_AT_A_TIME.iter().map(|(_, f)| *f).collect();
+    files.dedup();
+    for portable in files {
         let text = file(portable);
         if !out.contains(text.as_ref()) {
             continue;
