@@ -24,24 +24,45 @@ fn wide_bytes(w: vec2<u32>, half: u32) -> u32 {
 }
 
 /// Which children of `n` the ray enters within t: for an interior child in slot i the bit 24 + (i ^ oct) (its
-/// visiting rank), for a leaf its primitives' bits offset .. offset + count − 1. The decoded boxes are
-/// conservative (src/accel/wide_bvh.rs), so the robust slab test misses nothing the BVH2 would find.
+/// visiting rank), for a leaf its primitives' bits offset .. offset + count − 1.
+///
+/// The slab test runs in the node's quantised frame (Ylitie et al. 2017, §3.2): the plane at p + s·q is crossed at
+/// t = q·a + b with a = s/d and b = (p − o)/d, computed once per node, so a child's six planes cost a byte
+/// extraction, a conversion and a multiply-add each, and the near and far planes are chosen once per node by the
+/// direction's signs instead of a min and a max per plane. That form rounds differently from (p + s·q − o)/d —
+/// and b can be far larger than t when the node's origin is far from the ray's — so each axis' planes are widened
+/// by a bound on every rounding (of p + s·q, of b, of the product and the sum): pad = (|b| + |p/d| + 510·|a|)·2⁻²⁰,
+/// several times the worst case of four roundings of 2⁻²⁴ each. The decoded boxes are conservative
+/// (src/accel/wide_bvh.rs), so the widened test misses nothing the BVH2 would find. An axis whose terms overflow
+/// (a direction component near 0 against huge coordinates) does not constrain: its planes become ±F32_MAX.
 fn wide_node_hits(r: TraceRay, oct: u32, n: WideNode, t: f32) -> u32 {
     let p = bitcast<vec3<f32>>(n.head.xyz);
     let e = (vec3<u32>(n.head.w) >> vec3<u32>(0u, 8u, 16u)) & vec3<u32>(0xffu);
     let s = bitcast<vec3<f32>>(e << vec3<u32>(23u));
+    let a = s * r.inv_d;
+    let b = (p - r.o) * r.inv_d;
+    let pad = (abs(b) + abs(p * r.inv_d) + 510.0 * abs(a)) * 9.5367431640625e-7;
+    let finite = abs(b) + pad <= vec3<f32>(F32_MAX) & 255.0 * abs(a) <= vec3<f32>(F32_MAX);
+    let a_f = select(vec3<f32>(0.0), a, finite);
+    let b_near = select(vec3<f32>(-F32_MAX), b - pad, finite);
+    let b_far = select(vec3<f32>(F32_MAX), b + pad, finite);
+    // Along a negative direction component the upper edge is crossed first.
+    let neg = r.inv_d < vec3<f32>(0.0);
     var hits = 0u;
     for (var half = 0u; half < 2u; half++) {
         let meta_w = wide_bytes(n.links.zw, half);
         let lo_w = vec3<u32>(wide_bytes(n.q_lo_xy.xy, half), wide_bytes(n.q_lo_xy.zw, half), wide_bytes(n.q_lo_z_hi_x.xy, half));
         let hi_w = vec3<u32>(wide_bytes(n.q_lo_z_hi_x.zw, half), wide_bytes(n.q_hi_yz.xy, half), wide_bytes(n.q_hi_yz.zw, half));
+        let near_w = select(lo_w, hi_w, neg);
+        let far_w = select(hi_w, lo_w, neg);
         for (var k = 0u; k < 4u; k++) {
             let sh = 8u * k;
             let m = (meta_w >> sh) & 0xffu;
-            // s·q is exact (a power of two times a byte), so p + s·q rounds once, as on the CPU.
-            let lo = p + s * vec3<f32>((lo_w >> vec3<u32>(sh)) & vec3<u32>(0xffu));
-            let hi = p + s * vec3<f32>((hi_w >> vec3<u32>(sh)) & vec3<u32>(0xffu));
-            let entered = ray_box_entry(r, lo, hi, t) != F32_MAX;
+            let tn = vec3<f32>((near_w >> vec3<u32>(sh)) & vec3<u32>(0xffu)) * a_f + b_near;
+            let tf = vec3<f32>((far_w >> vec3<u32>(sh)) & vec3<u32>(0xffu)) * a_f + b_far;
+            let enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+            let leave = min(min(tf.x, tf.y), tf.z) * BVH_SLAB_FAR_SCALE;
+            let entered = enter <= min(leave, t);
             let count = m >> 5u;
             let slot = 4u * half + k;
             let bits = select(((1u << count) - 1u) << (m & 31u), 1u << (24u + (slot ^ oct)), count == 0u);
@@ -71,7 +92,9 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     // Bit k set where the direction is negative: slot i is visited at rank i ^ oct.
     let oct = select(0u, 1u, r.d.x < 0.0) | select(0u, 2u, r.d.y < 0.0) | select(0u, 4u, r.d.z < 0.0);
     // The root as a node group of one: rank oct is slot 0, and imask 0 makes it child_base + 0.
-    var g = vec2<u32>(0u, 1u << (24u + oct));
+    // A ray with a non-finite origin or direction hits nothing (wide_node_hits would let its NaN axes through).
+    let finite_ray = all(abs(r.o) <= vec3<f32>(F32_MAX)) && all(abs(r.inv_d) <= vec3<f32>(F32_MAX));
+    var g = vec2<u32>(0u, select(0u, 1u << (24u + oct), finite_ray));
     var tg = vec2<u32>(0u, 0u);
     var sp = 0u;
     // Every node is loaded at most once and pushes at most one entry: these bound both loops.

@@ -977,7 +977,11 @@ fn gpu_watertight_through_edges_and_vertices() {
     // (edge functions of the two triangles disagreeing in sign) would let some through.
     let ctx = gpu();
     let mut rng = Pcg64::seed_from_u64(31);
-    for (center, size) in [(Vec3::ZERO, 1.0f32), (Vec3::new(700.0, -300.0, 1200.0), 50.0)] {
+    // The far meshes: a node's origin far from the ray's and from the world's, where the wide slab test's node-frame
+    // form (shaders/bvh_wide.wgsl `wide_node_hits`) leans on its rounding pad.
+    let meshes =
+        [(Vec3::ZERO, 1.0f32), (Vec3::new(700.0, -300.0, 1200.0), 50.0), (Vec3::new(-2.0e4, 1.0e4, 3.0e4), 400.0)];
+    for (center, size) in meshes {
         let tris = closed_mesh(12, size, center, &mut rng);
         let g = Geometry { tris, spheres: vec![], quads: vec![] };
         // Both layouts: the BVH2 with 50 000 rays, the wide tree with 20 000.
@@ -988,7 +992,13 @@ fn gpu_watertight_through_edges_and_vertices() {
                     let e = rng.random_range(0..3);
                     // A vertex, or a point on an edge interpolated in f32 as a renderer would.
                     let target = if k % 4 == 0 { t[e] } else { t[e].lerp(t[(e + 1) % 3], rng.random::<f32>()) };
-                    let o = center + (unit(&mut rng) * 0.05).as_vec3() * size * rng.random::<f32>();
+                    // Every eighth ray starts just inside the surface, a thousandth of the way from its vertex
+                    // target to the centre: a short ray through large nodes, whose origins are far from its own.
+                    let o = if k % 8 == 4 {
+                        target + (center - target) * 1e-3
+                    } else {
+                        center + (unit(&mut rng) * 0.05).as_vec3() * size * rng.random::<f32>()
+                    };
                     let d = (target - o).normalize();
                     ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
                 })
@@ -1010,6 +1020,58 @@ fn gpu_watertight_through_edges_and_vertices() {
             assert_eq!(far, 0, "{far} rays hit away from their aim point (mesh at {center}, size {size})");
         }
     }
+}
+
+#[test]
+fn gpu_wide_traversal_finds_axis_aligned_corners_far_from_the_origin() {
+    // An axis-aligned cube of 16×16 quads a face, far from the world's origin, with every vertex and edge midpoint
+    // exactly representable: faces lie on the quantised boxes' planes and rays aimed at grid points pass exactly
+    // through box edges and corners, where a slab test that rounds past its interval drops a box. Half the rays
+    // start a thousandth of the way in from their target (short rays through nodes whose origins are far away).
+    let ctx = gpu();
+    let mut rng = Pcg64::seed_from_u64(77);
+    let (n, h, center) = (16, 64.0f32, Vec3::new(20_000.0, -9_000.0, 31_000.0));
+    let grid = |v: glam::IVec3| center + (v.as_vec3() * (2.0 / n as f32) - 1.0) * h;
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        for side in [0, n] {
+            for i in 0..n {
+                for j in 0..n {
+                    let p = |a: i32, b: i32| {
+                        let mut v = glam::IVec3::ZERO;
+                        v[axis] = side;
+                        v[(axis + 1) % 3] = a;
+                        v[(axis + 2) % 3] = b;
+                        grid(v)
+                    };
+                    tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                    tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+                }
+            }
+        }
+    }
+    let g = Geometry { tris, spheres: vec![], quads: vec![] };
+    let b = g.build_wide();
+    let rays: Vec<(f64, ProbeRay)> = (0..40_000)
+        .map(|k| {
+            let t = g.tris[rng.random_range(0..g.tris.len())];
+            let e = rng.random_range(0..3);
+            let target = if k % 2 == 0 { t[e] } else { (t[e] + t[(e + 1) % 3]) * 0.5 };
+            let o = if k % 4 < 2 {
+                target + (center - target) * 1e-3
+            } else {
+                center + (unit(&mut rng) * 0.5).as_vec3() * h * rng.random::<f32>()
+            };
+            let d = (target - o).normalize();
+            ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
+        })
+        .collect();
+    let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
+    let out = gpu_trace_source(&ctx, &g, &b, &inputs, &wide_source());
+    let misses = out.iter().filter(|h| h.prim == INVALID).count();
+    let far = out.iter().zip(&rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-3).count();
+    assert_eq!(misses, 0, "{misses} of {} rays through the cube's grid points leaked", rays.len());
+    assert_eq!(far, 0, "{far} rays hit away from their grid point");
 }
 
 // ---------------------------------------------------------------------------------------------------------------

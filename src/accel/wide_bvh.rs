@@ -19,8 +19,10 @@
 //! parent. A ray visits slot `rank ^ octant` at `rank` = 0, 1, …, 7, with bit k of `octant` set where the direction
 //! is negative: near children first without sorting by distance.
 //!
-//! Quantisation is conservative: the decoded box, evaluated in f32 exactly as the shader does (`p + s·q`; `s·q` is
-//! exact, so an fma gives the same bits), contains the child's box, so the wide tree finds the same closest hits.
+//! Quantisation is conservative: the decoded box, evaluated in f32 (`p + s·q`; `s·q` is exact, so an fma gives the
+//! same bits), contains the child's box. The shader's slab test works in the node's frame instead (t = q·s/d +
+//! (p − o)/d) and widens each plane by a bound on that form's roundings (`wide_node_hits`), so the wide tree finds
+//! the same closest hits.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
