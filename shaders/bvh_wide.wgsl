@@ -97,19 +97,29 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     var g = vec2<u32>(0u, select(0u, 1u << (24u + oct), finite_ray));
     var tg = vec2<u32>(0u, 0u);
     var sp = 0u;
+    // The stack's top entry is held in registers (`top`, when `top_full`) and only the ones below it in workgroup
+    // memory: lavapipe runs each workgroup-memory access as a loop over the SIMD lanes, and most pushed groups are
+    // popped again before anything else is pushed (docs/profile-bvh.md, "The top entry in registers").
+    var top = vec2<u32>(0u, 0u);
+    var top_full = false;
     // Every node is loaded at most once and pushes at most one entry: these bound both loops.
     let bound = 3u * wide_node_count() + 1u;
-    for (var round = 0u; round < bound && ((g.y & WIDE_NODE_BITS) != 0u || tg.y != 0u || sp > 0u); round++) {
+    for (var round = 0u; round < bound && ((g.y & WIDE_NODE_BITS) != 0u || tg.y != 0u || sp > 0u || top_full); round++) {
         // A lane steps until it holds a leaf group, then waits for the others: each iteration loads one node, so
         // a lane finds at most one leaf group per iteration and never has to push one. (Speculating on, as the
         // BVH2 loop does, gained nothing on the wide tree and cost a second push in every step: lavapipe runs a
         // store as a loop over the SIMD lanes whether or not a lane stores; docs/profile-bvh.md.)
-        for (var step = 0u; step < bound && tg.y == 0u && ((g.y & WIDE_NODE_BITS) != 0u || sp > 0u); step++) {
+        for (var step = 0u; step < bound && tg.y == 0u && ((g.y & WIDE_NODE_BITS) != 0u || sp > 0u || top_full); step++) {
             // Pop and step in one iteration: lanes run in lockstep, so an iteration spent only popping idles the
             // lanes that have a node to visit (the BVH2 loop measured the same).
             if (g.y & WIDE_NODE_BITS) == 0u {
-                sp -= 1u;
-                let e = bvh_stack[base + sp];
+                var e = top;
+                if top_full {
+                    top_full = false;
+                } else {
+                    sp -= 1u;
+                    e = bvh_stack[base + sp];
+                }
                 if (e.y & WIDE_NODE_BITS) != 0u {
                     g = e;
                 } else {
@@ -122,7 +132,11 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
                 let idx = g.x + countOneBits(g.y & ((1u << slot) - 1u));
                 g.y &= ~(1u << bit);
                 if (g.y & WIDE_NODE_BITS) != 0u {
-                    wide_push(base, &sp, g);
+                    if top_full {
+                        wide_push(base, &sp, top);
+                    }
+                    top = g;
+                    top_full = true;
                 }
                 let node = wide_node(idx);
                 let hits = wide_node_hits(r, oct, node, hit.t);
