@@ -942,6 +942,12 @@ fn closed_mesh(n: i32, size: f32, center: Vec3, rng: &mut Pcg64) -> Vec<[Vec3; 3
         let bump = 1.0 + 0.15 * (3.0 * c.x).sin() * (2.0 * c.y).cos() * (2.5 * c.z + 1.0).sin();
         center + rot * (c.normalize() * bump * size)
     };
+    cube_faces(n, vert)
+}
+
+/// The six n×n grids of a cube's surface, two triangles a cell (alternating diagonals, so vertices have different
+/// valences), with lattice point p placed at `vert(p)`: the vertices shared across faces are bit-identical.
+fn cube_faces(n: i32, vert: impl Fn(glam::IVec3) -> Vec3) -> Vec<[Vec3; 3]> {
     let mut tris = Vec::new();
     for axis in 0..3 {
         for side in [0, n] {
@@ -1032,24 +1038,7 @@ fn gpu_wide_traversal_finds_axis_aligned_corners_far_from_the_origin() {
     let mut rng = Pcg64::seed_from_u64(77);
     let (n, h, center) = (16, 64.0f32, Vec3::new(20_000.0, -9_000.0, 31_000.0));
     let grid = |v: glam::IVec3| center + (v.as_vec3() * (2.0 / n as f32) - 1.0) * h;
-    let mut tris = Vec::new();
-    for axis in 0..3 {
-        for side in [0, n] {
-            for i in 0..n {
-                for j in 0..n {
-                    let p = |a: i32, b: i32| {
-                        let mut v = glam::IVec3::ZERO;
-                        v[axis] = side;
-                        v[(axis + 1) % 3] = a;
-                        v[(axis + 2) % 3] = b;
-                        grid(v)
-                    };
-                    tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
-                    tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
-                }
-            }
-        }
-    }
+    let tris = cube_faces(n, grid);
     let g = Geometry { tris, spheres: vec![], quads: vec![] };
     let b = g.build_wide();
     let rays: Vec<(f64, ProbeRay)> = (0..40_000)
