@@ -6,7 +6,8 @@
 override WIDE_BVH: bool = false;
 
 /// One 8-wide node, 80 bytes as five vec4 (mirrors `GpuWideNode` in src/accel/wide_bvh.rs, whose module docs give
-/// the encoding): five loads per node step, each testing eight quantised boxes.
+/// the encoding): five 16-byte loads per node step, or three 32-byte ones (geometry_loads_int64.wgsl), each step
+/// testing eight quantised boxes.
 struct WideNode {
     head: vec4<u32>,
     links: vec4<u32>,
