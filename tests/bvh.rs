@@ -933,6 +933,19 @@ fn gpu_far_small_sphere() {
     assert!(s.hits > 4000, "{} hits", s.hits);
 }
 
+/// A ray from `o` towards `target`, with the distance at which it should hit there.
+fn aimed_ray(o: Vec3, target: Vec3) -> (f64, ProbeRay) {
+    let d = (target - o).normalize();
+    ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
+}
+
+/// How many aimed rays missed, and how many hit farther than `tol` (relative) from their aim point.
+fn misses_and_strays(out: &[ProbeTrace], rays: &[(f64, ProbeRay)], tol: f64) -> (usize, usize) {
+    let misses = out.iter().filter(|h| h.prim == INVALID).count();
+    let far = out.iter().zip(rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > tol).count();
+    (misses, far)
+}
+
 /// A closed, bumpy "cube sphere": six n×n grids whose vertices are a function of their integer lattice point, so
 /// the vertices shared across faces are bit-identical. Rotated randomly, scaled by `size`, moved to `center`.
 fn closed_mesh(n: i32, size: f32, center: Vec3, rng: &mut Pcg64) -> Vec<[Vec3; 3]> {
@@ -1005,18 +1018,12 @@ fn gpu_watertight_through_edges_and_vertices() {
                     } else {
                         center + (unit(&mut rng) * 0.05).as_vec3() * size * rng.random::<f32>()
                     };
-                    let d = (target - o).normalize();
-                    ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
+                    aimed_ray(o, target)
                 })
                 .collect();
             let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
             let out = gpu_trace_source(&ctx, &g, &b, &inputs, &source);
-            let misses = out.iter().filter(|h| h.prim == INVALID).count();
-            let far = out
-                .iter()
-                .zip(&rays)
-                .filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-4)
-                .count();
+            let (misses, far) = misses_and_strays(&out, &rays, 1e-4);
             assert_eq!(
                 misses,
                 0,
@@ -1051,14 +1058,12 @@ fn gpu_wide_traversal_finds_axis_aligned_corners_far_from_the_origin() {
             } else {
                 center + (unit(&mut rng) * 0.5).as_vec3() * h * rng.random::<f32>()
             };
-            let d = (target - o).normalize();
-            ((target - o).length() as f64, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 })
+            aimed_ray(o, target)
         })
         .collect();
     let inputs: Vec<ProbeRay> = rays.iter().map(|r| r.1).collect();
     let out = gpu_trace_source(&ctx, &g, &b, &inputs, &wide_source());
-    let misses = out.iter().filter(|h| h.prim == INVALID).count();
-    let far = out.iter().zip(&rays).filter(|(h, (dist, _))| h.prim != INVALID && rel(h.t as f64, *dist) > 1e-3).count();
+    let (misses, far) = misses_and_strays(&out, &rays, 1e-3);
     assert_eq!(misses, 0, "{misses} of {} rays through the cube's grid points leaked", rays.len());
     assert_eq!(far, 0, "{far} rays hit away from their grid point");
 }
