@@ -75,8 +75,12 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     var beta = ray.beta * s.next_weight;
     if (want_next && ray.bounce + 1u >= params.rr_depth) {
         // Russian roulette, decided before the ray is traced: a surviving path counts what it finds with β/q (as
-        // pbrt-v4 does). Continue with probability max(β), at least 5%.
-        let q = clamp(max(beta.x, max(beta.y, beta.z)), 0.05, 1.0);
+        // pbrt-v4 does). Continue with probability this vertex's own scattering weight f·cos/pdf (largest channel,
+        // at least 5 %), not the whole throughput's max(β) as pbrt-v4 and Mitsuba 3 do: β is then held where it was
+        // when roulette began instead of being lifted back to 1, so no survivor carries 1/β₃ (8× on a grey 0.5
+        // scene) and far fewer paths die at the first roulette. Measured 1.3–1.4× as efficient (1 / (relMSE ·
+        // time)) on the interiors, the helmet and the Cornell box (docs/estimators.md, "Russian roulette").
+        let q = clamp(max(s.next_weight.x, max(s.next_weight.y, s.next_weight.z)), 0.05, 1.0);
         if (sample_1d(c.id, dim_base(ray.bounce, 0u) + DIM_RR) >= q) { return false; }
         beta /= q;
     }
