@@ -42,6 +42,12 @@ fn direction_technique(c: ShadingCtx) -> u32 {
     return STRATEGY_BSDF;
 }
 
+/// The normal a light sample may use to skip directions a shading point cannot receive from (`light_sample_li`):
+/// its shading normal n where its BSDF only reflects, 0 where it transmits (light arrives from both sides).
+fn env_receiver(n: vec3<f32>, transmits: bool) -> vec3<f32> {
+    return select(n, vec3<f32>(0.0), transmits);
+}
+
 /// Whether world direction w (local wi) leaves c on a side its BSDF does not allow: a reflection must leave
 /// above the geometric surface and a transmission below it (a shading normal must not leak light through).
 fn wrong_side(c: ShadingCtx, w: vec3<f32>, wi: vec3<f32>) -> bool {
@@ -142,7 +148,7 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     let li = pick.index;
     let pmf = pick.pmf;
     let u = vec3<f32>(sample_2d(c.id, base + DIM_LIGHT_UV), sample_1d(c.id, base + DIM_LIGHT_EXTRA));
-    let ls = light_sample_li(li, c.x.p, u);
+    let ls = light_sample_li(li, c.x.p, env_receiver(c.x.ns, bsdf_transmits(c.brdf)), u);
     out.m = ls.m;
     if (!(ls.pdf > 0.0) || !(pmf > 0.0)) { return out; }
     // The light must be on a side the BSDF allows, by both the shading and the geometric normal.
@@ -172,7 +178,7 @@ struct RisCandidate {
 fn ris_candidate(c: ShadingCtx, u: vec4<f32>) -> RisCandidate {
     var r = RisCandidate(no_light_sample(), vec3<f32>(0.0), 0.0);
     let pick = select_light(u.x, c.x.p, c.x.ns);
-    r.ls = light_sample_li(pick.index, c.x.p, u.yzw);
+    r.ls = light_sample_li(pick.index, c.x.p, env_receiver(c.x.ns, bsdf_transmits(c.brdf)), u.yzw);
     r.ls.pdf *= pick.pmf;
     let cos_s = dot(r.ls.wi, c.x.ns);
     let wi = to_local(c.frame, r.ls.wi);
@@ -254,18 +260,19 @@ fn light_measure_known() -> bool {
 }
 
 /// Block 2, the direction technique: the MIS weight of emission `found` along w, a direction it sampled from the
-/// shading point `from_p` (shading normal from_n) with pdf p_dir, against the light technique's pdf of w
-/// (selection included). `known`: the measure of the first light sample taken at from_p.
-fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, from_n: vec3<f32>, w: vec3<f32>, known: LightMeasure) -> f32 {
+/// shading point `from_p` (shading normal from_n; `from_transmits`: its BSDF transmits) with pdf p_dir, against
+/// the light technique's pdf of w (selection included). `known`: the measure of the first light sample taken at
+/// from_p.
+fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, from_n: vec3<f32>, from_transmits: bool, w: vec3<f32>, known: LightMeasure) -> f32 {
     if (!mis_on()) { return 1.0; }
     var p_light = 0.0;
     if (found.light == params.env_light) {
-        p_light = env_pdf(w);
+        p_light = env_pdf(w, env_receiver(from_n, from_transmits));
     } else {
         var m = known;
         if (!light_measure_known()) { m = light_measure(found.light, from_p); }
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
-        p_light = light_pdf_li(found.light, m, from_p, w, found.surface.p, found.surface.ng);
+        p_light = light_pdf_li(found.light, m, from_p, env_receiver(from_n, from_transmits), w, found.surface.p, found.surface.ng);
     }
     return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(found.light, from_p, from_n) * p_light);
 }
@@ -351,7 +358,7 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
             if (all(found.le == vec3<f32>(0.0))) { continue; }
             let f = direction_f(c, ds);
             var mis = 1.0;
-            if (!ds.delta) { mis = direction_mis_weight(ds.pdf, found, c.x.p, c.x.ns, w, out.light); }
+            if (!ds.delta) { mis = direction_mis_weight(ds.pdf, found, c.x.p, c.x.ns, bsdf_transmits(c.brdf), w, out.light); }
             out.radiance += mis * found.le * f * abs(ds.wi.z) / ds.pdf * plan.dir_scale;
         }
     }

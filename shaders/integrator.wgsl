@@ -26,6 +26,7 @@ struct PathRay {
     d: vec3<f32>,
     from_p: vec3<f32>,       // the shading point it leaves (for the light technique's pdf of what it finds)
     from_n: vec3<f32>,       // its shading normal (the light tree's selection depends on it)
+    from_transmits: bool,    // its BSDF transmits (a constant environment's light sample then ignores from_n)
     dir_pdf: f32,            // pdf of the direction technique that chose d
     dir_delta: bool,         // d is a delta lobe's sample: no light technique competes, MIS weight 1
     emission_scale: f32,     // factor on the emission it finds (0: not a counted direction sample)
@@ -42,6 +43,7 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
     r.d = camera_direction(px, sample_2d(id, 0u));
     r.from_p = params.cam_origin;
     r.from_n = vec3<f32>(0.0);
+    r.from_transmits = false;
     r.dir_pdf = 0.0;
     r.dir_delta = false;
     r.emission_scale = 1.0;
@@ -62,7 +64,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     // The camera ray is no direction technique's sample: its emission counts in full.
     var w = ray.emission_scale;
     if (ray.bounce > 0u && w > 0.0 && !ray.dir_delta && any(found.le != vec3<f32>(0.0))) {
-        w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.d, ray.light);
+        w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.from_transmits, ray.d, ray.light);
     }
     (*r).l += ray.beta * (w * found.le);
     if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
@@ -90,6 +92,7 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     (*r).d = s.next_dir;
     (*r).from_p = x.p;
     (*r).from_n = x.ns;
+    (*r).from_transmits = bsdf_transmits(c.brdf);
     (*r).dir_pdf = s.next_pdf;
     (*r).dir_delta = s.next_delta;
     (*r).emission_scale = s.next_scale;

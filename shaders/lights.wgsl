@@ -489,9 +489,23 @@ fn env_texel_index(uv: vec2<f32>) -> u32 {
     return y * params.env_width + x;
 }
 
-/// Whether the environment is sampled uniformly on the sphere (constant, or by the setting).
+/// Whether the environment's radiance is one constant (no map).
+fn env_constant() -> bool {
+    return ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u);
+}
+
+/// Whether the environment is sampled uniformly on the sphere (a constant one seen from no particular surface, or by
+/// the setting).
 fn env_uniform() -> bool {
-    return ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u) || cfg_env_sampling() == ENV_SAMPLING_UNIFORM;
+    return env_constant() || cfg_env_sampling() == ENV_SAMPLING_UNIFORM;
+}
+
+/// Whether a constant environment is sampled by the cosine about the receiver's normal `n` (0: no normal, as for
+/// surfaces that transmit): L·cos is then ∝ cos, so this is importance sampling of the light times the cosine —
+/// no sample is spent below the surface, where uniform sampling puts half of them. `--env-sampling uniform` keeps
+/// the uniform sphere.
+fn env_cosine(n: vec3<f32>) -> bool {
+    return env_constant() && cfg_env_sampling() == ENV_SAMPLING_IMPORTANCE && any(n != vec3<f32>(0.0));
 }
 
 /// Radiance arriving from direction w (piecewise constant over texels, matching the sampling density).
@@ -501,10 +515,11 @@ fn env_radiance(w: vec3<f32>) -> vec3<f32> {
     return env_texels[env_texel_index(env_direction_to_uv(w))].xyz * params.env_scale;
 }
 
-/// pdf (solid angle) of `env_sample` producing w: 1/4π (uniform), or density_uv / (2π² sinθ) (importance).
-/// sinθ = |w.xz| (1 − w.y² loses its digits near the poles).
-fn env_pdf(w: vec3<f32>) -> f32 {
+/// pdf (solid angle) of `env_sample(·, n)` producing w: max(w·n, 0)/π (a constant map, cosine about n), 1/4π
+/// (uniform), or density_uv / (2π² sinθ) (importance). sinθ = |w.xz| (1 − w.y² loses its digits near the poles).
+fn env_pdf(w: vec3<f32>, n: vec3<f32>) -> f32 {
     if (ENV_KIND == 0u) { return 0.0; }
+    if (env_cosine(n)) { return max(dot(w, n), 0.0) * INV_PI; }
     if (env_uniform()) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
     let density_uv = env_texels[env_texel_index(uv)].w;
@@ -512,17 +527,26 @@ fn env_pdf(w: vec3<f32>) -> f32 {
     return density_uv / (2.0 * PI * PI * max(sin_theta, 1e-7));
 }
 
-/// Uniform on the sphere, or a texel ∝ luminance·sinθ by the alias table (column from u.z, coin from u.y, which is
-/// then reused) and uniform in (u, v) inside the texel, so pdf_ω = density_uv / (2π² sinθ). The pdf returned is
-/// the chosen texel's: at a texel edge, f32 rounding may map the direction into the neighbour, where `env_pdf`
-/// (and a black neighbour's radiance) would differ on that measure-zero set. Measure: solid angle.
-fn env_sample(u: vec3<f32>) -> LightSample {
+/// Cosine-weighted about the receiver's normal n (a constant map: `env_cosine`), uniform on the sphere, or a texel
+/// ∝ luminance·sinθ by the alias table (column from u.z, coin from u.y, which is then reused) and uniform in (u, v)
+/// inside the texel, so pdf_ω = density_uv / (2π² sinθ). The pdf returned is the chosen texel's: at a texel edge,
+/// f32 rounding may map the direction into the neighbour, where `env_pdf` (and a black neighbour's radiance) would
+/// differ on that measure-zero set. Measure: solid angle.
+fn env_sample(u: vec3<f32>, n: vec3<f32>) -> LightSample {
+    if (env_cosine(n)) {
+        let local = square_to_cosine_hemisphere(u.xy);
+        if (!(local.z > 0.0)) { return no_light_sample(); }
+        let wi = to_world(frame_from_normal(n), local);
+        let pdf = max(dot(wi, n), 0.0) * INV_PI;
+        if (!(pdf > 0.0)) { return no_light_sample(); }
+        return LightSample(wi, F32_MAX, env_radiance(wi), pdf, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
+    }
     if (env_uniform()) {
         let wi = square_to_uniform_sphere(u.xy);
         return LightSample(wi, F32_MAX, env_radiance(wi), INV_FOUR_PI, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
     }
-    let n = params.env_width * params.env_height;
-    let pick = alias_sample2(0u, n, u.z, u.y, true);
+    let texels = params.env_width * params.env_height;
+    let pick = alias_sample2(0u, texels, u.z, u.y, true);
     let x = pick.index % params.env_width;
     let y = pick.index / params.env_width;
     let uv = vec2<f32>((f32(x) + u.x) / f32(params.env_width), (f32(y) + pick.u) / f32(params.env_height));
@@ -533,17 +557,19 @@ fn env_sample(u: vec3<f32>) -> LightSample {
     return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
 }
 
-fn environment_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample { return env_sample(u); }
+// The environment alone depends on the receiver's normal n (`env_cosine`); the other kinds ignore it.
+fn environment_sample_li(l: Light, p: vec3<f32>, n: vec3<f32>, u: vec3<f32>) -> LightSample { return env_sample(u, n); }
 fn environment_measure(l: Light, p: vec3<f32>) -> LightMeasure { return LightMeasure(MEASURE_SOLID_ANGLE, 0.0); }
-fn environment_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
-    return env_pdf(wi);
+fn environment_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, n: vec3<f32>, wi: vec3<f32>) -> f32 {
+    return env_pdf(wi, n);
 }
 fn environment_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return env_radiance(wi); }
 
 // ---- the dispatchers: one case per kind; a kind the scene lacks is compiled out by its HAS_* constant ----
 
-/// Samples light i as seen from p (without the selection probability).
-fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+/// Samples light i as seen from p (without the selection probability). n: the receiver's normal where it reflects
+/// only, else 0 (`env_receiver`): a constant environment is then sampled by the cosine about it.
+fn light_sample_li(i: u32, p: vec3<f32>, n: vec3<f32>, u: vec3<f32>) -> LightSample {
     let l = scene_light(i);
     switch (l.kind) {
         case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_sample_li(l, p, u); } }
@@ -552,7 +578,7 @@ fn light_sample_li(i: u32, p: vec3<f32>, u: vec3<f32>) -> LightSample {
         case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_sample_li(l, p, u); } }
         case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_sample_li(l, p, u); } }
         case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_sample_li(l, p, u); } }
-        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_sample_li(l, p, u); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_sample_li(l, p, n, u); } }
         default: {}
     }
     return no_light_sample();
@@ -574,9 +600,9 @@ fn light_measure(i: u32, p: vec3<f32>) -> LightMeasure {
     return LightMeasure(MEASURE_NONE, 0.0);
 }
 
-/// pdf (solid angle, without selection) that `light_sample_li(i, p, ·)` draws wi, meeting the light at y (n_y), given
-/// m = light_measure(i, p).
-fn light_pdf_li(i: u32, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+/// pdf (solid angle, without selection) that `light_sample_li(i, p, n, ·)` draws wi, meeting the light at y (n_y),
+/// given m = light_measure(i, p).
+fn light_pdf_li(i: u32, m: LightMeasure, p: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
     let l = scene_light(i);
     switch (l.kind) {
         case LIGHT_TRIANGLE: { if (HAS_TRIANGLE_LIGHTS) { return triangle_pdf_li(l, m, p, wi, y, n_y); } }
@@ -585,7 +611,7 @@ fn light_pdf_li(i: u32, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f3
         case LIGHT_POINT: { if (HAS_DELTA_LIGHTS) { return point_pdf_li(l, m, p, wi, y, n_y); } }
         case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_pdf_li(l, m, p, wi, y, n_y); } }
         case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_pdf_li(l, m, p, wi, y, n_y); } }
-        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_pdf_li(l, m, p, n, wi); } }
         default: {}
     }
     return 0.0;

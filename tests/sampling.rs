@@ -25,7 +25,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 79;
+const FAMILY: usize = 80;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -141,11 +141,11 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             o1.x = square_to_uniform_cone_pdf(probe_job.a.x);
         }
         case R_LIGHT: {
-            let s = light_sample_li(probe_job.light, p, u.xyz);
+            let s = light_sample_li(probe_job.light, p, vec3<f32>(0.0), u.xyz);
             o0 = vec4<f32>(s.wi, s.pdf);
             if (s.pdf > 0.0) {
                 let y = p + s.dist * s.wi;
-                o1 = vec4<f32>(light_pdf_li(probe_job.light, light_measure(probe_job.light, p), p, s.wi, y, probe_light_normal(probe_job.light, y)), s.dist, luminance(s.radiance), 0.0);
+                o1 = vec4<f32>(light_pdf_li(probe_job.light, light_measure(probe_job.light, p), p, vec3<f32>(0.0), s.wi, y, probe_light_normal(probe_job.light, y)), s.dist, luminance(s.radiance), 0.0);
             }
         }
         case R_BSDF: {
@@ -155,9 +155,10 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             o1.z = s.f.x;    // f of the sample (red), for the f / eval consistency test
         }
         case R_ENV: {
-            let s = env_sample(u.xyz);
+            // probe_job.a.xyz: the receiver's normal (0: none), which a constant environment is sampled about.
+            let s = env_sample(u.xyz, probe_job.a.xyz);
             o0 = vec4<f32>(s.wi, s.pdf);
-            if (s.pdf > 0.0) { o1 = vec4<f32>(env_pdf(s.wi), 0.0, luminance(s.radiance), 0.0); }
+            if (s.pdf > 0.0) { o1 = vec4<f32>(env_pdf(s.wi, probe_job.a.xyz), 0.0, luminance(s.radiance), 0.0); }
         }
         case R_SELECT: {
             let k = select_light(u.x, p, probe_job.a.xyz);
@@ -193,7 +194,7 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         case R_UNIFORM_SPHERE: { pdf = square_to_uniform_sphere_pdf(); }
         case R_CONE: { if (w.w != 0.0) { pdf = square_to_uniform_cone_pdf(probe_job.a.x); } }
         case R_LIGHT: {
-            if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, light_measure(probe_job.light, probe_job.p.xyz), probe_job.p.xyz, w.xyz, y, probe_light_normal(probe_job.light, y)); }
+            if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, light_measure(probe_job.light, probe_job.p.xyz), probe_job.p.xyz, vec3<f32>(0.0), w.xyz, y, probe_light_normal(probe_job.light, y)); }
         }
         case R_BSDF: {
             pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz);
@@ -201,7 +202,7 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
             probe_out[i] = vec4<f32>(pdf, bsdf_eval(probe_bsdf(), probe_job.p.xyz, w.xyz).x, bsdf_eval(probe_bsdf(), w.xyz, probe_job.p.xyz).x, 0.0);
             return;
         }
-        case R_ENV: { pdf = env_pdf(w.xyz); }
+        case R_ENV: { pdf = env_pdf(w.xyz, probe_job.a.xyz); }
         case R_SELECT: { pdf = light_pmf(u32(w.x), probe_job.p.xyz, probe_job.a.xyz); }
         default: {}
     }
@@ -1426,6 +1427,21 @@ fn env_case(
     c
 }
 
+/// The many-light scene's constant sky seen from a surface with normal n: sampled by the cosine about n.
+fn constant_env_cosine_case() -> Case {
+    let n = DVec3::new(0.3, -0.5, 0.8).normalize();
+    let mut s = Setup::new(SceneId::ManyLights, R_ENV);
+    s.job.a = v4(n, 0.0);
+    let mut c = Case::new(
+        "environment cosine",
+        "constant sky, receiver normal (0.3, −0.5, 0.8)".into(),
+        s,
+        Dom::Cap(SphereCap::sphere(n, GRID)),
+    );
+    c.base = Quadrature { sub: 1, gauss: 2 };
+    c
+}
+
 fn env_cases() -> Vec<Case> {
     // Texel edges fall inside cells (so an f32 sample on an edge never lands in a cell of pdf 0) but on sub-cell
     // boundaries of the quadrature; pdf·Jacobian is constant inside a texel, so one point per sub-cell is exact.
@@ -1466,6 +1482,7 @@ fn env_cases() -> Vec<Case> {
             None,
             false,
         ),
+        constant_env_cosine_case(),
     ]
 }
 
