@@ -81,7 +81,8 @@ settings_enum!(
     EnvSampling, "ENV_SAMPLING_" {
         /// Uniform on the sphere.
         Uniform = 0 => "uniform",
-        /// Proportional to luminance·sinθ of the equirectangular map.
+        /// Proportional to luminance·sinθ of the equirectangular map; a constant environment by the cosine about
+        /// the receiving surface's normal (its L·cos, exactly).
         Importance = 1 => "importance",
     }
 );
