@@ -131,12 +131,15 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
     let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);
     var a = accum[pixel];
     var bad = 0u;
-    if (FLAT_SCENE && cfg_mode() == MODE_PATH) {
+    if (cfg_mode() == MODE_PATH && (FLAT_SCENE || SPEC_MODE == MODE_PATH)) {
         // One loop over path vertices, not one per sample: a lane whose path ends starts its next sample at
         // once. lavapipe runs a loop's SIMD lanes until the last one is done, so with a loop per sample every
-        // lane waited for the longest path among its neighbours'. Measured: this pays on baked path tracing only;
-        // in direct mode (at most two vertices) and with a BVH (lanes that restart apart walk the tree apart) the
-        // loop per sample below is 5–15 % faster.
+        // lane waited for the longest path among its neighbours'. In direct mode (at most two vertices) the loop
+        // per sample below is faster. BVH scenes once measured 5–15 % faster with it too (lanes that restart apart
+        // walk the tree apart); since roulette keeps paths longer (2026-12-04) this loop is 0.85–0.94× the time on
+        // Mesa 25.0.7 and 0.93–1.0× on Mesa 22.3.6 there as well (docs/estimators.md, "One path loop"). Only where
+        // the mode is fixed at compile time for a BVH scene: a generic pipeline (the viewer's) would compile both
+        // loops, each with the whole traversal inlined, and lavapipe took 10 minutes over that instead of seconds.
         var ray = camera_ray(px, SampleId(pixel, params.sample_base));
         var started = 1u;
         var done = 0u;
