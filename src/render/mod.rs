@@ -20,5 +20,6 @@ pub mod settings;
 pub mod shaders;
 pub mod shading_data;
 pub mod tile_order;
+pub mod void_and_cluster;
 
 pub use renderer::*;
