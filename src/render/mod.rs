@@ -13,6 +13,7 @@ pub mod lights;
 pub mod pipeline_cache;
 pub mod progressive;
 pub mod reachability;
+pub mod render_module;
 pub mod renderer;
 pub mod samplers;
 pub mod scene_data;
