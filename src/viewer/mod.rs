@@ -7,6 +7,7 @@ pub mod app;
 pub mod camera;
 pub mod display;
 pub mod engine;
+pub mod widgets;
 
 use crate::gpu::GpuContext;
 use crate::render::film::Tonemap;
