@@ -23,4 +23,5 @@ pub mod shading_data;
 pub mod tile_order;
 pub mod void_and_cluster;
 
+pub use render_module::{render_source, render_source_for, RENDER_FILES};
 pub use renderer::*;

@@ -10,7 +10,7 @@ use crate::render::features::{Features, PipelineKey};
 use crate::render::film::Film;
 use crate::render::gpu_scene::GpuScene;
 use crate::render::pipeline_cache::PipelineCache;
-pub use crate::render::render_module::{render_source, render_source_for, RENDER_FILES};
+use crate::render::render_module::{render_source, render_source_for};
 pub use crate::render::settings::RR_DEPTH;
 use crate::render::settings::{Mode, Settings};
 use crate::render::shaders;
