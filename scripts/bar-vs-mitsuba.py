@@ -26,6 +26,7 @@ p.add_argument("--ref-spp", type=int, default=1024)
 p.add_argument("--mislab", default="target/release/mislab")
 p.add_argument("--cache", default="/tmp/mislab-bar")
 p.add_argument("--threads", type=int, default=2)
+p.add_argument("--mislab-args", default="", help="extra mislab render arguments (an A/B of a setting), e.g. '--env-sampling importance'")
 a = p.parse_args()
 
 os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
@@ -71,7 +72,7 @@ for factor, label in ((2.0, "2T"), (1.0, "T"), (0.5, "T/2")):
     out = cache / f"{stem}-mislab-{label.replace('/', '_')}.exr"
     cmd = [a.mislab, "render", str(toml), "--mode", "path", "--max-depth", "8", "--strategy", "mis",
            "--heuristic", "power", "--sampler", "sobol", "--width", str(a.width), "--height", str(a.height),
-           "--time", f"{factor * T:.3f}", "-o", str(out), "--force"]
+           "--time", f"{factor * T:.3f}", "-o", str(out), "--force"] + a.mislab_args.split()
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         sys.exit(f"mislab failed ({r.returncode}): {' '.join(cmd)}\n{r.stderr}")

@@ -40,6 +40,7 @@ const LIGHT_SAMPLING_SOLID_ANGLE: u32 = 1u;
 
 const ENV_SAMPLING_UNIFORM: u32 = 0u;
 const ENV_SAMPLING_IMPORTANCE: u32 = 1u;
+const ENV_SAMPLING_GUIDED: u32 = 2u;
 
 const LIGHT_SELECT_UNIFORM: u32 = 0u;
 const LIGHT_SELECT_POWER: u32 = 1u;
@@ -263,6 +264,16 @@ struct FrameParams {
     /// Workgroup row j of the dispatch renders tile row (j · stride) mod rows (src/render/tile_order.rs).
     tile_row_stride: u32,
     _pad2: u32,
+    /// The environment guide's grid (src/render/env_guide.rs): its lower corner, 1 / cell size, cells per axis.
+    guide_min: vec3<f32>,
+    /// > 0: the guide's learning pass (GUIDE_LEARN: also accumulated; GUIDE_LEARN_ONLY: counts only).
+    guide_train: u32,
+    guide_inv_cell: vec3<f32>,
+    /// The guide's slots (cells × 6 normal classes).
+    guide_slots: u32,
+    guide_dims: vec3<u32>,
+    /// 1 once a guide has been learned (guide_cdf holds it).
+    guide_on: u32,
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;

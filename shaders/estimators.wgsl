@@ -156,7 +156,12 @@ fn light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     let wi = to_local(c.frame, ls.wi);
     if (cos_s == 0.0 || (cos_s < 0.0 && !bsdf_transmits(c.brdf)) || wrong_side(c, ls.wi, wi)) { return out; }
     let f = bsdf_eval(c.brdf, c.wo, wi);
-    if (all(f * ls.radiance == vec3<f32>(0.0)) || !unoccluded(c.x, ls)) { return out; }
+    if (all(f * ls.radiance == vec3<f32>(0.0))) { return out; }
+    let visible = unoccluded(c.x, ls);
+    if (ENV_KIND != 0u && li == params.env_light) {
+        env_guide_learn_shadow_ray(c.x.p, env_receiver(c.x.ns, bsdf_transmits(c.brdf)), ls.wi, visible);
+    }
+    if (!visible) { return out; }
     let p_light = pmf * ls.pdf;
     var w = 1.0;
     if (mis_on() && ls.m.measure != MEASURE_DISCRETE) {
@@ -267,7 +272,7 @@ fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, from_n: vec
     if (!mis_on()) { return 1.0; }
     var p_light = 0.0;
     if (found.light == params.env_light) {
-        p_light = env_pdf(w, env_receiver(from_n, from_transmits));
+        p_light = env_pdf(w, from_p, env_receiver(from_n, from_transmits));
     } else {
         var m = known;
         if (!light_measure_known()) { m = light_measure(found.light, from_p); }

@@ -67,6 +67,9 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
         w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.from_transmits, ray.d, ray.light);
     }
     (*r).l += ray.beta * (w * found.le);
+    if (hit.prim == INVALID && ray.bounce > 0u && !ray.dir_delta) {
+        env_guide_learn_escape(ray.from_p, env_receiver(ray.from_n, ray.from_transmits), ray.d);
+    }
     if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
     let x = found.surface;
     let c = shading_ctx(x, scene_material(x.material), ray.d, ray.id, ray.bounce);
@@ -159,6 +162,8 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
             accumulate(&a, &bad, ray.l);
         }
     }
+    // The environment guide's learning pass of a render resumed past its sample 0 only counts (`env_guide_learn_*`).
+    if (params.guide_train == GUIDE_LEARN_ONLY) { return; }
     a.nonfinite += bad;
     accum[pixel] = a;
     if (bad > 0u) { atomicAdd(&counters[0], bad); }

@@ -503,9 +503,130 @@ fn env_uniform() -> bool {
 /// Whether a constant environment is sampled by the cosine about the receiver's normal `n` (0: no normal, as for
 /// surfaces that transmit): L·cos is then ∝ cos, so this is importance sampling of the light times the cosine —
 /// no sample is spent below the surface, where uniform sampling puts half of them. `--env-sampling uniform` keeps
-/// the uniform sphere.
+/// the uniform sphere; `guided` mixes the cosine with the learned guide (`env_guide_slot`).
 fn env_cosine(n: vec3<f32>) -> bool {
-    return env_constant() && cfg_env_sampling() == ENV_SAMPLING_IMPORTANCE && any(n != vec3<f32>(0.0));
+    return env_constant() && cfg_env_sampling() != ENV_SAMPLING_UNIFORM && any(n != vec3<f32>(0.0));
+}
+
+// ---- the environment guide (src/render/env_guide.rs): where a constant environment is visible from, learned ----
+// Inside a room a constant sky is seen through the windows only, so most cosine-distributed shadow rays are
+// blocked. The render's first sample (a learning pass, guide_train > 0) counts, per slot — a cell of a grid over
+// the scene and the dominant axis of the receiver's normal — its cosine-sampled shadow rays, those that reached
+// the sky, and the directions (GUIDE_BINS equal-area bins) in which they and its paths' continuations reached it;
+// the host turns the counts into one CDF per slot and a probability alpha. `--env-sampling guided` then draws from
+// alpha·guide + (1 − alpha)·cosine: the cosine share keeps every direction the integrand can use reachable, so
+// the estimate stays unbiased whatever the guide learned.
+
+// The constants below are src/render/env_guide.rs's (tests/layout.rs checks them).
+/// guide_train: a learning pass that also accumulates its samples (a render's sample 0).
+const GUIDE_LEARN: u32 = 1u;
+/// guide_train: a learning pass that only counts (sample 0 again, for a render resumed past it).
+const GUIDE_LEARN_ONLY: u32 = 2u;
+
+const GUIDE_Z_BINS: u32 = 8u;
+const GUIDE_PHI_BINS: u32 = 16u;
+const GUIDE_BINS: u32 = 128u;
+/// The solid angle of one bin (4π / GUIDE_BINS: bins are equal in z = w.y and in φ).
+const GUIDE_BIN_SOLID_ANGLE: f32 = 0.09817477;
+
+/// The guide's slot for a receiver at p (clamped into the grid) with normal n.
+fn env_guide_slot(p: vec3<f32>, n: vec3<f32>) -> u32 {
+    let dims = params.guide_dims;
+    let c = min(vec3<u32>(max(floor((p - params.guide_min) * params.guide_inv_cell), vec3<f32>(0.0))), dims - 1u);
+    let a = abs(n);
+    var axis = 2u;
+    if (a.x >= a.y && a.x >= a.z) { axis = 0u; } else if (a.y >= a.z) { axis = 1u; }
+    let side = 2u * axis + select(0u, 1u, n[axis] < 0.0);
+    return ((c.z * dims.y + c.y) * dims.x + c.x) * 6u + side;
+}
+
+/// The equal-area bin of direction w: 8 bands of w.y, 16 sectors of φ = atan2(w.z, w.x).
+fn env_guide_bin(w: vec3<f32>) -> u32 {
+    let iz = min(u32(max((w.y + 1.0) * 0.5 * f32(GUIDE_Z_BINS), 0.0)), GUIDE_Z_BINS - 1u);
+    let phi = atan2(w.z, w.x) * INV_TWO_PI + 0.5;
+    let ip = min(u32(max(phi * f32(GUIDE_PHI_BINS), 0.0)), GUIDE_PHI_BINS - 1u);
+    return iz * GUIDE_PHI_BINS + ip;
+}
+
+/// The probability of drawing from the guide rather than the cosine in `slot`, which the host stores in place of
+/// the CDF's last entry (always 1): higher where the sky was seen by fewer of the learning pass's shadow rays, 0
+/// where the slot has no guide (too few counts, or the sky seen almost everywhere, where the cosine is best).
+fn env_guide_alpha(slot: u32) -> f32 {
+    return guide_cdf[slot * GUIDE_BINS + GUIDE_BINS - 1u];
+}
+
+/// The guide's slot for a receiver, or INVALID where the cosine alone is used (not guided, no guide learned yet,
+/// no normal, or a slot without counts).
+fn env_guided_slot(p: vec3<f32>, n: vec3<f32>) -> u32 {
+    if (cfg_env_sampling() != ENV_SAMPLING_GUIDED || params.guide_on == 0u || !env_cosine(n)) { return INVALID; }
+    let slot = env_guide_slot(p, n);
+    if (!(env_guide_alpha(slot) > 0.0)) { return INVALID; }
+    return slot;
+}
+
+/// The guide's density (solid angle) of direction bin b in `slot` (the last bin's CDF entry is 1).
+fn env_guide_pdf(slot: u32, b: u32) -> f32 {
+    let base = slot * GUIDE_BINS;
+    let lo = select(0.0, guide_cdf[base + max(b, 1u) - 1u], b > 0u);
+    let hi = select(guide_cdf[base + b], 1.0, b == GUIDE_BINS - 1u);
+    return (hi - lo) * (1.0 / GUIDE_BIN_SOLID_ANGLE);
+}
+
+/// The guided mixture's density of w (cosine density `cosine` about the receiver's normal) in `slot`, its bin b,
+/// with the slot's guide probability alpha.
+fn env_guided_pdf(slot: u32, alpha: f32, b: u32, cosine: f32) -> f32 {
+    return alpha * env_guide_pdf(slot, b) + (1.0 - alpha) * cosine;
+}
+
+/// The bin of `slot` whose CDF interval holds u0 (binary search; it never reads the last entry, which holds alpha).
+fn env_guide_pick(slot: u32, u0: f32) -> u32 {
+    let base = slot * GUIDE_BINS;
+    var lo = 0u;
+    var hi = GUIDE_BINS - 1u;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (guide_cdf[base + mid] > u0) { hi = mid; } else { lo = mid + 1u; }
+    }
+    return lo;
+}
+
+/// The direction at uv inside direction bin b (uniform in z and φ is uniform in solid angle).
+fn env_guide_bin_direction(b: u32, uv: vec2<f32>) -> vec3<f32> {
+    let iz = b / GUIDE_PHI_BINS;
+    let ip = b % GUIDE_PHI_BINS;
+    let z = clamp(-1.0 + 2.0 * (f32(iz) + uv.x) / f32(GUIDE_Z_BINS), -1.0, 1.0);
+    let phi = TWO_PI * ((f32(ip) + uv.y) / f32(GUIDE_PHI_BINS) - 0.5);
+    let r = safe_sqrt(1.0 - z * z);
+    return vec3<f32>(r * cos(phi), z, r * sin(phi));
+}
+
+/// Whether this pass learns the guide at a receiver with normal n (`env_receiver`).
+fn env_guide_learning(n: vec3<f32>) -> bool {
+    let learning = params.guide_train == GUIDE_LEARN || params.guide_train == GUIDE_LEARN_ONLY;
+    return cfg_env_sampling() == ENV_SAMPLING_GUIDED && learning && env_cosine(n);
+}
+
+/// Learning: a cosine-sampled shadow ray towards the sky from a receiver at p with normal n along w, `visible` or
+/// not. The slot counts its shadow rays and those that reached the sky (their ratio sets its alpha), and the bin
+/// of each that did: such a ray's weight L·cos/pdf is the same (π·L) for all, so a count per ray estimates ∫ V·cos
+/// over the bin. The slot's counts follow its GUIDE_BINS bin counts (src/render/env_guide.rs `counts_words`).
+fn env_guide_learn_shadow_ray(p: vec3<f32>, n: vec3<f32>, w: vec3<f32>, visible: bool) {
+    if (!env_guide_learning(n)) { return; }
+    let slot = env_guide_slot(p, n);
+    let tallies = params.guide_slots * GUIDE_BINS + 2u * slot;
+    atomicAdd(&guide_counts[tallies], 1u);
+    if (visible) {
+        atomicAdd(&guide_counts[tallies + 1u], 1u);
+        atomicAdd(&guide_counts[slot * GUIDE_BINS + env_guide_bin(w)], 1u);
+    }
+}
+
+/// Learning: a path's continuation from a receiver at p with normal n that reached the sky along w counts in its
+/// bin too (its weight is the shadow ray's for a Lambert surface; for others an approximation, which only the
+/// guide's quality depends on).
+fn env_guide_learn_escape(p: vec3<f32>, n: vec3<f32>, w: vec3<f32>) {
+    if (!env_guide_learning(n)) { return; }
+    atomicAdd(&guide_counts[env_guide_slot(p, n) * GUIDE_BINS + env_guide_bin(w)], 1u);
 }
 
 /// Radiance arriving from direction w (piecewise constant over texels, matching the sampling density).
@@ -515,11 +636,18 @@ fn env_radiance(w: vec3<f32>) -> vec3<f32> {
     return env_texels[env_texel_index(env_direction_to_uv(w))].xyz * params.env_scale;
 }
 
-/// pdf (solid angle) of `env_sample(·, n)` producing w: max(w·n, 0)/π (a constant map, cosine about n), 1/4π
+/// pdf (solid angle) of `env_sample(·, p, n)` producing w: max(w·n, 0)/π (a constant map, cosine about n; guided:
+/// mixed with the guide of p's slot), 1/4π
 /// (uniform), or density_uv / (2π² sinθ) (importance). sinθ = |w.xz| (1 − w.y² loses its digits near the poles).
-fn env_pdf(w: vec3<f32>, n: vec3<f32>) -> f32 {
+fn env_pdf(w: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
     if (ENV_KIND == 0u) { return 0.0; }
-    if (env_cosine(n)) { return max(dot(w, n), 0.0) * INV_PI; }
+    if (env_cosine(n)) {
+        // Below the surface the density is 0 whatever the guide holds: `env_sample` drops the guide's samples there.
+        let cosine = max(dot(w, n), 0.0) * INV_PI;
+        let slot = env_guided_slot(p, n);
+        if (slot == INVALID || !(cosine > 0.0)) { return cosine; }
+        return env_guided_pdf(slot, env_guide_alpha(slot), env_guide_bin(w), cosine);
+    }
     if (env_uniform()) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
     let density_uv = env_texels[env_texel_index(uv)].w;
@@ -532,12 +660,27 @@ fn env_pdf(w: vec3<f32>, n: vec3<f32>) -> f32 {
 /// inside the texel, so pdf_ω = density_uv / (2π² sinθ). The pdf returned is the chosen texel's: at a texel edge,
 /// f32 rounding may map the direction into the neighbour, where `env_pdf` (and a black neighbour's radiance) would
 /// differ on that measure-zero set. Measure: solid angle.
-fn env_sample(u: vec3<f32>, n: vec3<f32>) -> LightSample {
+fn env_sample(u: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     if (env_cosine(n)) {
-        let local = square_to_cosine_hemisphere(u.xy);
-        if (!(local.z > 0.0)) { return no_light_sample(); }
-        let wi = to_world(frame_from_normal(n), local);
-        let pdf = max(dot(wi, n), 0.0) * INV_PI;
+        let slot = env_guided_slot(p, n);
+        var wi: vec3<f32>;
+        var pdf: f32;
+        var alpha = 0.0;
+        if (slot != INVALID) { alpha = env_guide_alpha(slot); }
+        if (u.z < alpha) {
+            // The guide's share: its bins cover the whole sphere, so a direction below the surface is a lost sample.
+            let b = env_guide_pick(slot, u.z / alpha);
+            wi = env_guide_bin_direction(b, u.xy);
+            let cosine = dot(wi, n);
+            if (!(cosine > 0.0)) { return no_light_sample(); }
+            pdf = env_guided_pdf(slot, alpha, b, cosine * INV_PI);
+        } else {
+            let local = square_to_cosine_hemisphere(u.xy);
+            if (!(local.z > 0.0)) { return no_light_sample(); }
+            wi = to_world(frame_from_normal(n), local);
+            pdf = max(dot(wi, n), 0.0) * INV_PI;
+            if (slot != INVALID) { pdf = env_guided_pdf(slot, alpha, env_guide_bin(wi), pdf); }
+        }
         if (!(pdf > 0.0)) { return no_light_sample(); }
         return LightSample(wi, F32_MAX, env_radiance(wi), pdf, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
     }
@@ -558,10 +701,10 @@ fn env_sample(u: vec3<f32>, n: vec3<f32>) -> LightSample {
 }
 
 // The environment alone depends on the receiver's normal n (`env_cosine`); the other kinds ignore it.
-fn environment_sample_li(l: Light, p: vec3<f32>, n: vec3<f32>, u: vec3<f32>) -> LightSample { return env_sample(u, n); }
+fn environment_sample_li(l: Light, p: vec3<f32>, n: vec3<f32>, u: vec3<f32>) -> LightSample { return env_sample(u, p, n); }
 fn environment_measure(l: Light, p: vec3<f32>) -> LightMeasure { return LightMeasure(MEASURE_SOLID_ANGLE, 0.0); }
 fn environment_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, n: vec3<f32>, wi: vec3<f32>) -> f32 {
-    return env_pdf(wi, n);
+    return env_pdf(wi, p, n);
 }
 fn environment_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return env_radiance(wi); }
 

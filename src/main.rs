@@ -318,14 +318,23 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     let film = renderer.film(&ctx).map_err(|e| bad(e.to_string()))?;
     let attributes = mislab::lab::reference::header_attributes(&args.scene, &settings, &stats);
     film.save_to(&target, settings.exposure, args.tonemap, &attributes).map_err(bad)?;
+    let extra = if stats.extra_rows > 0 {
+        format!(" (and one more in {} of {} rows)", stats.extra_rows, settings.height)
+    } else {
+        String::new()
+    };
+    let samples = stats.spp as f64 * pixels + (stats.extra_rows * settings.width) as f64;
     eprintln!(
-        "{} spp in {:.2} s: {:.2} M samples/s, {:.2} Mrays/s, {} NaN/Inf samples",
+        "{} spp in {:.2} s{extra}: {:.2} M samples/s, {:.2} Mrays/s, {} NaN/Inf samples",
         stats.spp,
         stats.seconds,
-        stats.spp as f64 * pixels / stats.seconds.max(1e-9) / 1e6,
+        samples / stats.seconds.max(1e-9) / 1e6,
         stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
         stats.nonfinite
     );
+    if let Some((guided, slots)) = renderer.guide_coverage() {
+        eprintln!("environment guide: {guided} of {slots} slots (region × normal) draw sky samples from it");
+    }
     if stats.interrupted {
         eprintln!(
             "interrupted: wrote the {} samples per pixel accumulated so far to {}",

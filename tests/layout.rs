@@ -136,7 +136,13 @@ fn shared_structs_match() {
             offset_scale,
             ris_candidates,
             tile_row_stride,
-            _pad2
+            _pad2,
+            guide_min,
+            guide_train,
+            guide_inv_cell,
+            guide_slots,
+            guide_dims,
+            guide_on
         ]
     );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
@@ -207,6 +213,11 @@ fn tag_constants_match() {
         ("LIGHT_LEAF_BIT", mislab::accel::light_tree::LEAF_BIT),
         // The light tree's empty child is the shader's INVALID.
         ("INVALID", mislab::accel::light_tree::EMPTY),
+        ("GUIDE_Z_BINS", mislab::render::env_guide::Z_BINS as u32),
+        ("GUIDE_PHI_BINS", mislab::render::env_guide::PHI_BINS as u32),
+        ("GUIDE_BINS", mislab::render::env_guide::BINS as u32),
+        ("GUIDE_LEARN", mislab::render::env_guide::LEARN),
+        ("GUIDE_LEARN_ONLY", mislab::render::env_guide::LEARN_ONLY),
     ] {
         assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");
     }

@@ -25,7 +25,7 @@ const N: u32 = 1 << 20;
 /// Family-wise significance level of all chi-square tests in this file.
 const ALPHA: f64 = 0.01;
 /// Number of chi-square tests in the family (checked against the case lists below).
-const FAMILY: usize = 80;
+const FAMILY: usize = 81;
 /// Bins of the direction domains (rows × columns).
 const GRID: (usize, usize) = (100, 200);
 /// The pdf a sampler returns and its pdf function at the sample must agree to PDF_MATCH (relative) for all but a
@@ -155,10 +155,13 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             o1.z = s.f.x;    // f of the sample (red), for the f / eval consistency test
         }
         case R_ENV: {
-            // probe_job.a.xyz: the receiver's normal (0: none), which a constant environment is sampled about.
-            let s = env_sample(u.xyz, probe_job.a.xyz);
+            // probe_job.a.xyz: the receiver's normal (0: none), which a constant environment is sampled about;
+            // probe_job.p.xyz: its position (the guide's slot, under `guided`).
+            let s = env_sample(u.xyz, probe_job.p.xyz, probe_job.a.xyz);
             o0 = vec4<f32>(s.wi, s.pdf);
-            if (s.pdf > 0.0) { o1 = vec4<f32>(env_pdf(s.wi, probe_job.a.xyz), 0.0, luminance(s.radiance), 0.0); }
+            if (s.pdf > 0.0) {
+                o1 = vec4<f32>(env_pdf(s.wi, probe_job.p.xyz, probe_job.a.xyz), 0.0, luminance(s.radiance), 0.0);
+            }
         }
         case R_SELECT: {
             let k = select_light(u.x, p, probe_job.a.xyz);
@@ -202,7 +205,7 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
             probe_out[i] = vec4<f32>(pdf, bsdf_eval(probe_bsdf(), probe_job.p.xyz, w.xyz).x, bsdf_eval(probe_bsdf(), w.xyz, probe_job.p.xyz).x, 0.0);
             return;
         }
-        case R_ENV: { pdf = env_pdf(w.xyz, probe_job.a.xyz); }
+        case R_ENV: { pdf = env_pdf(w.xyz, probe_job.p.xyz, probe_job.a.xyz); }
         case R_SELECT: { pdf = light_pmf(u32(w.x), probe_job.p.xyz, probe_job.a.xyz); }
         default: {}
     }
@@ -1442,6 +1445,49 @@ fn constant_env_cosine_case() -> Case {
     c
 }
 
+/// The guide of `guided_env_cosine_case`: one cell, and in the slot of normals along +z a CDF over the bins whose
+/// weights favour the upper bands and one sector (bins below the receiver's surface included, whose samples are
+/// lost), its share alpha = 0.7 in the last entry. The other slots stay zero (the cosine alone).
+fn probe_guide() -> Vec<f32> {
+    use mislab::render::env_guide::{BINS, NORMAL_CLASSES, PHI_BINS};
+    let mut cdf = vec![0f32; NORMAL_CLASSES * BINS];
+    let slot = 4; // +z
+    let weight = |b: usize| 1.0 + 20.0 * ((b / PHI_BINS) >= 5) as u32 as f64 + 8.0 * (b % PHI_BINS == 3) as u32 as f64;
+    let total: f64 = (0..BINS).map(weight).sum();
+    let mut run = 0.0;
+    for b in 0..BINS {
+        run += weight(b);
+        cdf[slot * BINS + b] = (run / total) as f32;
+    }
+    cdf[slot * BINS + BINS - 1] = 0.7;
+    cdf
+}
+
+/// The many-light scene's constant sky seen from a surface with normal n, `--env-sampling guided`: the cosine
+/// about n mixed with `probe_guide` (the slot of normals along +z, the grid one cell).
+fn guided_env_cosine_case() -> Case {
+    let n = DVec3::new(0.3, -0.5, 0.8).normalize();
+    let mut s = Setup::new(SceneId::ManyLights, R_ENV);
+    s.job.a = v4(n, 0.0);
+    s.frame.env_sampling = EnvSampling::Guided.tag();
+    s.frame.guide_on = 1;
+    s.frame.guide_dims = [1, 1, 1];
+    s.frame.guide_min = [-1e4; 3];
+    s.frame.guide_inv_cell = [1e-5; 3];
+    s.frame.guide_slots = mislab::render::env_guide::NORMAL_CLASSES as u32;
+    let mut c = Case::new(
+        "environment guided",
+        "constant sky, normal (0.3, −0.5, 0.8), a guide of alpha 0.7".into(),
+        s,
+        Dom::Cap(SphereCap::sphere(n, GRID)),
+    );
+    // The pdf steps at the bins' edges, which do not follow the cap's cells: 6×6 points a cell.
+    c.base = Quadrature { sub: 3, gauss: 2 };
+    // The guide's directions below the surface are lost samples (the pdf is 0 there): ∫pdf + failures/N = 1.
+    c.may_fail = true;
+    c
+}
+
 fn env_cases() -> Vec<Case> {
     // Texel edges fall inside cells (so an f32 sample on an edge never lands in a cell of pdf 0) but on sub-cell
     // boundaries of the quadrature; pdf·Jacobian is constant inside a texel, so one point per sub-cell is exact.
@@ -1483,11 +1529,14 @@ fn env_cases() -> Vec<Case> {
             false,
         ),
         constant_env_cosine_case(),
+        guided_env_cosine_case(),
     ]
 }
 
 #[test]
 fn chi2_environment() {
+    // Only the guided case reads the guide (the others' frames have guide_on = 0).
+    harness().pipelines.write_guide(harness().ctx, &probe_guide());
     run_all("env", &env_cases());
 }
 

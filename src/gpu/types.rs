@@ -226,6 +226,17 @@ pub struct GpuFrameParams {
     /// Workgroup row j of the dispatch renders tile row (j · stride) mod rows (`render::tile_order`).
     pub tile_row_stride: u32,
     pub _pad2: u32,
+    /// The environment guide's grid: lower corner (render-origin space), 1 / cell size, cells per axis
+    /// (`render::env_guide`).
+    pub guide_min: [f32; 3],
+    /// > 0: the guide's learning pass (1: its samples also accumulate; 2: it only counts).
+    pub guide_train: u32,
+    pub guide_inv_cell: [f32; 3],
+    /// The guide's slots (cells × 6 normal classes).
+    pub guide_slots: u32,
+    pub guide_dims: [u32; 3],
+    /// 1 once a guide is learned.
+    pub guide_on: u32,
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

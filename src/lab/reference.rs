@@ -167,7 +167,7 @@ pub fn render_reference_from(
         let film = r.film(ctx).map_err(|e| e.to_string())?;
         if film.is_complete(r.samples() - first) {
             let spp = r.samples() - first;
-            let stats = RenderStats { spp, seconds, rays, nonfinite: r.nonfinite_total(), interrupted };
+            let stats = RenderStats { spp, extra_rows: 0, seconds, rays, nonfinite: r.nonfinite_total(), interrupted };
             return Ok((film, stats));
         }
         if dispatch == 1 {
@@ -183,6 +183,8 @@ pub fn render_reference_from(
 pub fn header_attributes(scene: &SceneSpec, settings: &Settings, stats: &RenderStats) -> Vec<(String, String)> {
     vec![
         ("spp".into(), stats.spp.to_string()),
+        // Rows of a time-budgeted render whose pixels hold one sample more (its last, partial pass).
+        ("extraSampleRows".into(), stats.extra_rows.to_string()),
         ("renderSeconds".into(), format!("{:.3}", stats.seconds)),
         ("nonfiniteSamples".into(), stats.nonfinite.to_string()),
         ("seed".into(), settings.seed.to_string()),

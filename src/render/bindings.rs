@@ -200,7 +200,7 @@ pub const SCENE: [SceneBinding; 20] = [
 ];
 
 /// Group 1: the per-render state, in binding order.
-pub const FRAME: [Binding; 4] = [
+pub const FRAME: [Binding; 6] = [
     Binding {
         group: 1,
         binding: 0,
@@ -242,6 +242,26 @@ pub const FRAME: [Binding; 4] = [
         label: "sampler tables",
         note:
             "The samplers' constant tables (src/render/samplers.rs `sampler_data`: Sobol matrices, primes, blue-noise mask).",
+    },
+    Binding {
+        group: 1,
+        binding: 4,
+        name: "guide_cdf",
+        wgsl_type: "array<f32>",
+        access: Access::Read,
+        element_size: 4,
+        label: "environment guide",
+        note: "The environment guide: per slot, the CDF over its direction bins (src/render/env_guide.rs).",
+    },
+    Binding {
+        group: 1,
+        binding: 5,
+        name: "guide_counts",
+        wgsl_type: "array<atomic<u32>>",
+        access: Access::ReadWrite,
+        element_size: 4,
+        label: "environment guide counts",
+        note: "What the guide's training dispatch counts: unblocked sky directions per slot and bin.",
     },
 ];
 

@@ -23,8 +23,10 @@ pub enum Budget {
 /// What a progressive render did.
 #[derive(Clone, Debug, Default)]
 pub struct RenderStats {
-    /// Samples per pixel accumulated.
+    /// Samples per pixel accumulated in every pixel.
     pub spp: u32,
+    /// Film rows that hold one sample more (a time budget's last, partial pass: `run`).
+    pub extra_rows: u32,
     /// Seconds spent rendering (submissions and waits).
     pub seconds: f64,
     /// Rays traced.
@@ -48,6 +50,7 @@ pub fn run(
     let start_samples = renderer.samples();
     let mut batch = 1u32;
     let mut interrupted = false;
+    let mut extra_rows = 0;
     loop {
         let done = renderer.samples() - start_samples;
         let elapsed = start.elapsed().as_secs_f64();
@@ -70,11 +73,23 @@ pub fn run(
         }
         let mut n = batch.min(remaining);
         if let Budget::Time(t) = budget {
-            // Do not overshoot the time budget by more than about one sample's time.
+            // Passes that fit in the time left, at the time per pass so far. Whole passes as long as one fits; then
+            // one sample more in as many film rows as fit, so the render ends near its budget instead of up to a
+            // whole pass before or after it (1.1 s at 640×360 in an interior on lavapipe, a fifth of a 2T budget).
+            // Each pixel's mean is over its own samples, so the image stays unbiased; those rows are a little less
+            // noisy.
             let per_sample = if done > 0 { elapsed / done as f64 } else { 0.0 };
             if per_sample > 0.0 {
-                let left = (t.as_secs_f64() - elapsed).max(0.0);
-                n = n.min(((left / per_sample).ceil() as u32).max(1));
+                let passes = (t.as_secs_f64() - elapsed).max(0.0) / per_sample;
+                if passes < 1.0 {
+                    let rows = (passes * renderer.settings().height as f64) as u32;
+                    if rows > 0 && !interrupt.load(Ordering::SeqCst) {
+                        renderer.render_rows(ctx, rows)?;
+                        extra_rows = rows;
+                    }
+                    break;
+                }
+                n = n.min(passes as u32);
             }
         }
         let t0 = Instant::now();
@@ -87,6 +102,7 @@ pub fn run(
     }
     Ok(RenderStats {
         spp: renderer.samples() - start_samples,
+        extra_rows,
         seconds: start.elapsed().as_secs_f64(),
         rays: renderer.rays_total(),
         nonfinite: renderer.nonfinite_total(),

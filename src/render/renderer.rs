@@ -5,6 +5,7 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::types::*;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
+use crate::render::env_guide;
 pub use crate::render::error::RenderError;
 use crate::render::features::{Features, PipelineKey};
 use crate::render::film::Film;
@@ -12,7 +13,7 @@ use crate::render::gpu_scene::GpuScene;
 use crate::render::pipeline_cache::PipelineCache;
 use crate::render::render_module::{render_source, render_source_for};
 pub use crate::render::settings::RR_DEPTH;
-use crate::render::settings::{Mode, Settings};
+use crate::render::settings::{EnvSampling, Mode, Settings, Strategy};
 use crate::render::shaders;
 use crate::render::tile_order::tile_row_stride;
 use crate::scene::Camera;
@@ -98,6 +99,18 @@ pub struct Renderer {
     /// This scene's render module (`render_source_for`) and the shared one (`render_source`).
     source: String,
     shared_source: String,
+    /// The environment guide (`--env-sampling guided`): its grid, per-slot CDFs, training counts, and whether it
+    /// is learned for the current camera and settings (reset forgets it).
+    guide_grid: env_guide::GuideGrid,
+    guide_cdf: wgpu::Buffer,
+    guide_counts: wgpu::Buffer,
+    guide_on: bool,
+    /// Slots of the learned guide that draw from it (alpha > 0).
+    guided_slots: usize,
+    /// What the next dispatch does for the guide (0: uses it; `env_guide::LEARN`, `LEARN_ONLY`: learns it).
+    guide_train: u32,
+    /// Whether the scene's environment is one constant (the only kind the guide serves).
+    env_is_constant: bool,
 }
 
 impl Renderer {
@@ -180,6 +193,20 @@ impl Renderer {
         });
         let sampler_data =
             ctx.storage_buffer("sampler_data", crate::render::samplers::sampler_data(), wgpu::BufferUsages::empty());
+        let d = &scene.data;
+        let env_is_constant = d.env_light.is_some() && d.env_size.0 == 0;
+        let guide_grid = env_guide::GuideGrid::of_scene(d, settings.width as u64 * settings.height as u64);
+        // The guide's buffers at full size only where a guide can serve (one word otherwise).
+        let guide_words = if env_is_constant { env_guide::counts_words(guide_grid.slots()) } else { 1 };
+        let guide_buffer = |label: &str| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 4 * guide_words as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let (guide_cdf, guide_counts) = (guide_buffer("guide_cdf"), guide_buffer("guide_counts"));
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
             layout: &layout1,
@@ -188,9 +215,10 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 1, resource: accum.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: counters.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: sampler_data.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: guide_cdf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: guide_counts.as_entire_binding() },
             ],
         });
-        let d = &scene.data;
         let film_height = settings.height;
         let mut r = Renderer {
             device,
@@ -224,6 +252,13 @@ impl Renderer {
             offset_scale: d.offset_scale,
             source: render_source_for(d),
             shared_source: render_source(),
+            guide_grid,
+            guide_cdf,
+            guide_counts,
+            guide_on: false,
+            guide_train: 0,
+            guided_slots: 0,
+            env_is_constant,
         };
         r.reset();
         Ok(r)
@@ -333,6 +368,7 @@ impl Renderer {
         self.pass = None;
         self.nonfinite_total = 0;
         self.rays_total = 0;
+        self.guide_on = false;
     }
 
     /// Continues from saved accumulators (a render state file, `state::RenderState`): the film holds `accum`
@@ -446,7 +482,8 @@ impl Renderer {
         GpuFrameParams {
             width: s.width,
             height: s.height,
-            sample_base: self.samples,
+            // The guide's learning pass is sample 0, wherever the render stands (`ensure_guide`).
+            sample_base: if self.guide_train == env_guide::LEARN_ONLY { 0 } else { self.samples },
             samples_per_dispatch: spp,
             seed: s.seed,
             mode: s.mode.tag(),
@@ -482,6 +519,12 @@ impl Renderer {
             ris_candidates: s.ris_candidates,
             tile_row_stride: tile_row_stride(s.height.div_ceil(8)),
             _pad2: 0,
+            guide_min: self.guide_grid.min.into(),
+            guide_train: self.guide_train,
+            guide_inv_cell: self.guide_grid.inv_cell.into(),
+            guide_slots: self.guide_grid.slots() as u32,
+            guide_dims: self.guide_grid.dims.into(),
+            guide_on: self.guide_on as u32,
         }
     }
 
@@ -549,6 +592,53 @@ impl Renderer {
         pass.dispatch_workgroups(self.settings.width.div_ceil(8), row_count.div_ceil(8), 1);
     }
 
+    /// Whether the settings sample the scene's environment by a guide (`--env-sampling guided`, a constant
+    /// environment, a strategy that takes light samples).
+    pub fn wants_guide(&self) -> bool {
+        let s = &self.settings;
+        self.env_is_constant
+            && s.env_sampling == EnvSampling::Guided
+            && matches!(s.strategy, Strategy::Light | Strategy::Mis)
+    }
+
+    /// Once the environment guide is learned: how many of its slots (region × normal class) draw sky samples from
+    /// it, and how many there are.
+    pub fn guide_coverage(&self) -> Option<(usize, usize)> {
+        self.guide_on.then_some((self.guided_slots, self.guide_grid.slots()))
+    }
+
+    /// Learns the environment guide for the current camera and settings if they want one and it is not learned
+    /// yet (`env_guide`): sample 0 of every pixel, rendered with the cosine alone, counts where the sky was seen;
+    /// the counts are read back and the CDFs uploaded. At sample 0 that pass is the render's first sample; a
+    /// render resumed (or a part started) past it renders sample 0 again, counting only, and so learns the same
+    /// guide: the image does not depend on where a render was stopped or split. The pipeline must be built
+    /// (`prepare`); a band pass in flight waits for its end.
+    pub fn ensure_guide(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        if self.guide_on || self.pass.is_some() || !self.wants_guide() {
+            return Ok(());
+        }
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.guide_counts, 0, None);
+        if self.samples == 0 {
+            self.guide_train = env_guide::LEARN;
+            self.record(&mut enc, 1, None);
+        } else {
+            self.guide_train = env_guide::LEARN_ONLY;
+            self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, None);
+        }
+        self.guide_train = 0;
+        self.queue.submit([enc.finish()]);
+        ctx.wait()?;
+        self.collect_counters(ctx)?;
+        let words = env_guide::counts_words(self.guide_grid.slots());
+        let counts: Vec<u32> = ctx.read_pod(&self.guide_counts, words)?;
+        let cdfs = env_guide::cdfs(&counts, &self.guide_grid, env_guide::POOL_RADIUS);
+        self.guided_slots = cdfs.chunks_exact(env_guide::BINS).filter(|c| c[env_guide::BINS - 1] > 0.0).count();
+        self.queue.write_buffer(&self.guide_cdf, 0, bytemuck::cast_slice(&cdfs));
+        self.guide_on = true;
+        Ok(())
+    }
+
     /// Renders `spp` more samples per pixel and waits for them (with the device timeout): dispatches of at most
     /// `max_dispatch_spp()` samples, one submission each, one wait at the end.
     pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), RenderError> {
@@ -558,6 +648,11 @@ impl Renderer {
         if self.warmed != Some(self.key()) {
             self.warm_up(ctx)?;
         }
+        // The guide's learning pass may be this call's first sample.
+        let before = self.samples;
+        if spp > 0 {
+            self.ensure_guide(ctx)?;
+        }
         // lavapipe (Mesa 22.3) gives each invocation one budget of 65535 loop iterations shared by all
         // its loops and silently stops looping when it is spent: a 1024-spp dispatch accumulated only
         // ~300-450 samples. Split into small dispatches (one submit each, so each sees its own
@@ -565,7 +660,7 @@ impl Renderer {
         let chunk = self.max_dispatch_spp();
         let pixels = self.settings.width as u64 * self.window.len() as u64;
         let mut in_flight = 0u64;
-        let mut left = spp;
+        let mut left = spp - (self.samples - before);
         while left > 0 {
             let n = left.min(chunk);
             let mut enc = self.device.create_command_encoder(&Default::default());
@@ -582,6 +677,22 @@ impl Renderer {
         Ok(())
     }
 
+    /// Renders one sample more in the next `rows` film rows of a pass (a band, as the viewer records them) and waits:
+    /// a time budget's last, partial pass (`progressive::run`). Returns whether the band completed the pass.
+    pub fn render_rows(&mut self, ctx: &GpuContext, rows: u32) -> Result<bool, RenderError> {
+        self.prepare()?;
+        if self.warmed != Some(self.key()) {
+            self.warm_up(ctx)?;
+        }
+        self.ensure_guide(ctx)?;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        let done = self.record_band(&mut enc, 1, rows, None);
+        self.queue.submit([enc.finish()]);
+        ctx.wait()?;
+        self.collect_counters(ctx)?;
+        Ok(done)
+    }
+
     /// Renders `spp` more samples per pixel like `render`, but waits after every dispatch and times each with
     /// `timer` (GPU time) and the wall clock, for benchmarks.
     pub fn render_timed(
@@ -593,8 +704,15 @@ impl Renderer {
         self.prepare()?;
         let mut timing = Timing { gpu: timer.as_ref().map(|_| 0.0), ..Timing::default() };
         let rays_before = self.rays_total;
+        // The guide's learning pass may be this call's first sample (timed like the others, without the GPU timer).
+        let before = self.samples;
+        if spp > 0 {
+            let t0 = Instant::now();
+            self.ensure_guide(ctx)?;
+            timing.wall += t0.elapsed().as_secs_f64();
+        }
         let chunk = self.max_dispatch_spp();
-        let mut left = spp;
+        let mut left = spp - (self.samples - before);
         while left > 0 {
             let n = left.min(chunk);
             let t0 = Instant::now();

@@ -84,6 +84,10 @@ settings_enum!(
         /// Proportional to luminance·sinθ of the equirectangular map; a constant environment by the cosine about
         /// the receiving surface's normal (its L·cos, exactly).
         Importance = 1 => "importance",
+        /// As importance, but a constant environment is drawn from the cosine mixed with a guide learned from the
+        /// render's first sample — where the sky is visible from, per region and normal (through windows, say;
+        /// src/render/env_guide.rs).
+        Guided = 2 => "guided",
     }
 );
 
@@ -215,7 +219,7 @@ impl Default for Settings {
             mode: Mode::Direct,
             strategy: Strategy::Mis,
             light_sampling: LightSampling::SolidAngle,
-            env_sampling: EnvSampling::Importance,
+            env_sampling: EnvSampling::Guided,
             light_select: LightSelect::Uniform,
             heuristic: Heuristic::Power,
             power_beta: 2.0,

@@ -220,6 +220,7 @@ impl Session {
         }
         Ok(RenderStats {
             spp: renderer.samples() - first,
+            extra_rows: 0,
             seconds: start.elapsed().as_secs_f64(),
             rays: renderer.rays_total() - rays_first,
             nonfinite: renderer.nonfinite_total(),

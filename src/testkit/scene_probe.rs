@@ -4,7 +4,8 @@
 //!
 //! Binding convention:
 //! - `@group(0)`: every scene binding of [`bindings::SCENE`] (the renderer's group 0, from the one binding table);
-//! - `@group(1)`: `@binding(0)` the frame uniform ([`bindings::FRAME`]`[0]`, `params`);
+//! - `@group(1)`: `@binding(0)` the frame uniform ([`bindings::FRAME`]`[0]`, `params`), `@binding(4)` and `(5)` the
+//!   environment guide's (zero unless `ScenePipelines::write_guide` wrote one);
 //! - `@group(2)` ([`SCENE_PROBE_GROUP`]): `@binding(0)` the job (`var<uniform>`, any struct), `@binding(1)` the
 //!   output (`var<storage, read_write>`), `@binding(2)` the input (`var<storage, read>`).
 //!
@@ -24,6 +25,8 @@ use super::probe::ProbeError;
 
 /// The bind group of a scene probe's own buffers (job, output, input).
 pub const SCENE_PROBE_GROUP: u32 = 2;
+/// Words of the probes' environment guide buffers: a one-cell grid's six slots of 128 bins, with room to spare.
+pub const PROBE_GUIDE_WORDS: u64 = 2048;
 /// Workgroup size the kernels must declare (`@workgroup_size(64)`): dispatches cover `invocations` with it.
 pub const SCENE_PROBE_WORKGROUP: u32 = 64;
 
@@ -41,6 +44,7 @@ pub struct ScenePipelines {
     io_layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     frame_group: wgpu::BindGroup,
+    guide_cdf: wgpu::Buffer,
     lock: Mutex<()>,
 }
 
@@ -64,7 +68,11 @@ impl ScenePipelines {
         });
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe frame"),
-            entries: &[bindings::layout_entry(&bindings::FRAME[0])],
+            entries: &[
+                bindings::layout_entry(&bindings::FRAME[0]),
+                bindings::layout_entry(&bindings::FRAME[4]),
+                bindings::layout_entry(&bindings::FRAME[5]),
+            ],
         });
         let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe io"),
@@ -91,12 +99,33 @@ impl ScenePipelines {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        // The environment guide's bindings (never learned in a probe: `guide_on` stays 0).
+        let guide_buffer = || {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("probe guide"),
+                size: 4 * PROBE_GUIDE_WORDS,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let (guide_cdf, guide_counts) = (guide_buffer(), guide_buffer());
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("probe frame"),
             layout: &frame_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() }],
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: guide_cdf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: guide_counts.as_entire_binding() },
+            ],
         });
-        Ok(ScenePipelines { entries, scene_layout, io_layout, params, frame_group, lock: Mutex::new(()) })
+        Ok(ScenePipelines { entries, scene_layout, io_layout, params, frame_group, guide_cdf, lock: Mutex::new(()) })
+    }
+
+    /// Writes an environment guide (`guide_cdf`, at most [`PROBE_GUIDE_WORDS`] words) for kernels whose frame
+    /// uniform sets `guide_on`.
+    pub fn write_guide(&self, ctx: &GpuContext, cdf: &[f32]) {
+        assert!(cdf.len() as u64 <= PROBE_GUIDE_WORDS, "a probe guide holds at most {PROBE_GUIDE_WORDS} words");
+        ctx.queue.write_buffer(&self.guide_cdf, 0, bytemuck::cast_slice(cdf));
     }
 
     /// Binds an uploaded scene as group 0.
