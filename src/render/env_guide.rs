@@ -7,7 +7,7 @@
 //! scene × the dominant axis of the receiver's normal — its shadow rays towards the sky, those that reached it,
 //! and the direction bins in which they and the paths' continuations reached it. Each slot's counts, pooled with
 //! its neighbours', become a CDF over [`BINS`] equal-area direction bins and a probability alpha of using it; the
-//! light technique then samples `alpha · guide + (1 − alpha) · cosine` (shaders/lights.wgsl, `env_sample`), so
+//! light technique then samples `alpha · guide + (1 − alpha) · cosine` (shaders/env_guide.wgsl; `env_sample` in lights.wgsl), so
 //! every direction the integrand needs keeps a density and the estimate stays unbiased whatever the guide learned.
 //! The guide is a function of the scene, camera, settings and seed only (integer counts of sample 0), so renders
 //! stay repeatable, and resumed or split ones learn the same guide (`Renderer::ensure_guide`).

@@ -25,6 +25,7 @@ pub const RENDER_FILES: &[&str] = &[
     "surface.wgsl",
     "alpha.wgsl",
     "lights.wgsl",
+    "env_guide.wgsl",
     "light_tree.wgsl",
     "light_tree_loads.wgsl",
     "mis.wgsl",

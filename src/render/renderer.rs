@@ -13,33 +13,18 @@ use crate::render::gpu_scene::GpuScene;
 use crate::render::pipeline_cache::PipelineCache;
 use crate::render::render_module::{render_source, render_source_for};
 pub use crate::render::settings::RR_DEPTH;
-use crate::render::settings::{EnvSampling, Mode, Settings, Strategy};
+use crate::render::settings::{Mode, Settings};
 use crate::render::shaders;
 use crate::render::tile_order::tile_row_stride;
 use crate::scene::Camera;
-use std::time::Instant;
+
+mod guide;
+mod timed;
+pub use timed::Timing;
 
 /// Most pixel samples `Renderer::render` submits before it waits on the device: bounds each wait well below
 /// `gpu::DEVICE_WAIT_TIMEOUT` however long the render, and the device's 32-bit ray counter between readbacks.
 pub const PIXEL_SAMPLES_PER_WAIT: u64 = 1 << 22;
-
-/// What a timed render did (`Renderer::render_timed`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Timing {
-    /// Sum of the render passes' GPU durations (timestamp queries); None without TIMESTAMP_QUERY.
-    pub gpu: Option<f64>,
-    /// Wall time of submitting and waiting (readbacks for metrics excluded).
-    pub wall: f64,
-    /// Rays traced.
-    pub rays: u64,
-}
-
-impl Timing {
-    /// GPU time where measured, else wall time.
-    pub fn seconds(&self) -> f64 {
-        self.gpu.unwrap_or(self.wall)
-    }
-}
 
 /// A sample pass recorded band by band (the viewer bounds its frame time this way): its samples per pixel and the
 /// first row not yet recorded.
@@ -592,53 +577,6 @@ impl Renderer {
         pass.dispatch_workgroups(self.settings.width.div_ceil(8), row_count.div_ceil(8), 1);
     }
 
-    /// Whether the settings sample the scene's environment by a guide (`--env-sampling guided`, a constant
-    /// environment, a strategy that takes light samples).
-    pub fn wants_guide(&self) -> bool {
-        let s = &self.settings;
-        self.env_is_constant
-            && s.env_sampling == EnvSampling::Guided
-            && matches!(s.strategy, Strategy::Light | Strategy::Mis)
-    }
-
-    /// Once the environment guide is learned: how many of its slots (region × normal class) draw sky samples from
-    /// it, and how many there are.
-    pub fn guide_coverage(&self) -> Option<(usize, usize)> {
-        self.guide_on.then_some((self.guided_slots, self.guide_grid.slots()))
-    }
-
-    /// Learns the environment guide for the current camera and settings if they want one and it is not learned
-    /// yet (`env_guide`): sample 0 of every pixel, rendered with the cosine alone, counts where the sky was seen;
-    /// the counts are read back and the CDFs uploaded. At sample 0 that pass is the render's first sample; a
-    /// render resumed (or a part started) past it renders sample 0 again, counting only, and so learns the same
-    /// guide: the image does not depend on where a render was stopped or split. The pipeline must be built
-    /// (`prepare`); a band pass in flight waits for its end.
-    pub fn ensure_guide(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
-        if self.guide_on || self.pass.is_some() || !self.wants_guide() {
-            return Ok(());
-        }
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&self.guide_counts, 0, None);
-        if self.samples == 0 {
-            self.guide_train = env_guide::LEARN;
-            self.record(&mut enc, 1, None);
-        } else {
-            self.guide_train = env_guide::LEARN_ONLY;
-            self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, None);
-        }
-        self.guide_train = 0;
-        self.queue.submit([enc.finish()]);
-        ctx.wait()?;
-        self.collect_counters(ctx)?;
-        let words = env_guide::counts_words(self.guide_grid.slots());
-        let counts: Vec<u32> = ctx.read_pod(&self.guide_counts, words)?;
-        let cdfs = env_guide::cdfs(&counts, &self.guide_grid, env_guide::POOL_RADIUS);
-        self.guided_slots = cdfs.chunks_exact(env_guide::BINS).filter(|c| c[env_guide::BINS - 1] > 0.0).count();
-        self.queue.write_buffer(&self.guide_cdf, 0, bytemuck::cast_slice(&cdfs));
-        self.guide_on = true;
-        Ok(())
-    }
-
     /// Renders `spp` more samples per pixel and waits for them (with the device timeout): dispatches of at most
     /// `max_dispatch_spp()` samples, one submission each, one wait at the end.
     pub fn render(&mut self, ctx: &GpuContext, spp: u32) -> Result<(), RenderError> {
@@ -691,48 +629,6 @@ impl Renderer {
         ctx.wait()?;
         self.collect_counters(ctx)?;
         Ok(done)
-    }
-
-    /// Renders `spp` more samples per pixel like `render`, but waits after every dispatch and times each with
-    /// `timer` (GPU time) and the wall clock, for benchmarks.
-    pub fn render_timed(
-        &mut self,
-        ctx: &GpuContext,
-        spp: u32,
-        mut timer: Option<&mut GpuTimer>,
-    ) -> Result<Timing, RenderError> {
-        self.prepare()?;
-        let mut timing = Timing { gpu: timer.as_ref().map(|_| 0.0), ..Timing::default() };
-        let rays_before = self.rays_total;
-        // The guide's learning pass may be this call's first sample (timed like the others, without the GPU timer).
-        let before = self.samples;
-        if spp > 0 {
-            let t0 = Instant::now();
-            self.ensure_guide(ctx)?;
-            timing.wall += t0.elapsed().as_secs_f64();
-        }
-        let chunk = self.max_dispatch_spp();
-        let mut left = spp - (self.samples - before);
-        while left > 0 {
-            let n = left.min(chunk);
-            let t0 = Instant::now();
-            let mut enc = self.device.create_command_encoder(&Default::default());
-            self.record(&mut enc, n, timer.as_deref_mut());
-            self.queue.submit([enc.finish()]);
-            ctx.wait()?;
-            timing.wall += t0.elapsed().as_secs_f64();
-            left -= n;
-            let full = timer.as_ref().is_some_and(|t| t.is_full());
-            if full || left == 0 {
-                if let (Some(t), Some(g)) = (timer.as_deref_mut(), timing.gpu.as_mut()) {
-                    *g += t.read(ctx)?.iter().sum::<f64>();
-                }
-                // Also bounds the device's 32-bit ray counter between readbacks.
-                self.collect_counters(ctx)?;
-            }
-        }
-        timing.rays = self.rays_total - rays_before;
-        Ok(timing)
     }
 
     /// Most samples per pixel one dispatch may take without exhausting a driver's per-invocation loop

@@ -22,6 +22,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("surface.wgsl", include_str!("../../shaders/surface.wgsl")),
     ("alpha.wgsl", include_str!("../../shaders/alpha.wgsl")),
     ("lights.wgsl", include_str!("../../shaders/lights.wgsl")),
+    ("env_guide.wgsl", include_str!("../../shaders/env_guide.wgsl")),
     ("light_tree.wgsl", include_str!("../../shaders/light_tree.wgsl")),
     ("light_tree_loads.wgsl", include_str!("../../shaders/light_tree_loads.wgsl")),
     ("light_tree_loads_int64.wgsl", include_str!("../../shaders/light_tree_loads_int64.wgsl")),

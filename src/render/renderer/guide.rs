@@ -1,0 +1,56 @@
+//! The `Renderer`'s side of the environment guide (`render::env_guide`): whether the settings want one, learning
+//! it from sample 0, and how much of it is used.
+
+use super::Renderer;
+use crate::gpu::{GpuContext, GpuError};
+use crate::render::env_guide;
+use crate::render::settings::{EnvSampling, Strategy};
+
+impl Renderer {
+    /// Whether the settings sample the scene's environment by a guide (`--env-sampling guided`, a constant
+    /// environment, a strategy that takes light samples).
+    pub fn wants_guide(&self) -> bool {
+        let s = &self.settings;
+        self.env_is_constant
+            && s.env_sampling == EnvSampling::Guided
+            && matches!(s.strategy, Strategy::Light | Strategy::Mis)
+    }
+
+    /// Once the environment guide is learned: how many of its slots (region × normal class) draw sky samples from
+    /// it, and how many there are.
+    pub fn guide_coverage(&self) -> Option<(usize, usize)> {
+        self.guide_on.then_some((self.guided_slots, self.guide_grid.slots()))
+    }
+
+    /// Learns the environment guide for the current camera and settings if they want one and it is not learned
+    /// yet (`env_guide`): sample 0 of every pixel, rendered with the cosine alone, counts where the sky was seen;
+    /// the counts are read back and the CDFs uploaded. At sample 0 that pass is the render's first sample; a
+    /// render resumed (or a part started) past it renders sample 0 again, counting only, and so learns the same
+    /// guide: the image does not depend on where a render was stopped or split. The pipeline must be built
+    /// (`prepare`); a band pass in flight waits for its end.
+    pub fn ensure_guide(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        if self.guide_on || self.pass.is_some() || !self.wants_guide() {
+            return Ok(());
+        }
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.guide_counts, 0, None);
+        if self.samples == 0 {
+            self.guide_train = env_guide::LEARN;
+            self.record(&mut enc, 1, None);
+        } else {
+            self.guide_train = env_guide::LEARN_ONLY;
+            self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, None);
+        }
+        self.guide_train = 0;
+        self.queue.submit([enc.finish()]);
+        ctx.wait()?;
+        self.collect_counters(ctx)?;
+        let words = env_guide::counts_words(self.guide_grid.slots());
+        let counts: Vec<u32> = ctx.read_pod(&self.guide_counts, words)?;
+        let cdfs = env_guide::cdfs(&counts, &self.guide_grid, env_guide::POOL_RADIUS);
+        self.guided_slots = cdfs.chunks_exact(env_guide::BINS).filter(|c| c[env_guide::BINS - 1] > 0.0).count();
+        self.queue.write_buffer(&self.guide_cdf, 0, bytemuck::cast_slice(&cdfs));
+        self.guide_on = true;
+        Ok(())
+    }
+}
