@@ -1094,28 +1094,11 @@ fn light_tree_and_ris_agree_on_the_veach_gltf_scene() {
 // ---------------------------------------------------------------------------------------------------
 // The environment guide (`--env-sampling guided`, src/render/env_guide.rs)
 
-/// A 4 × 2.5 × 4 room of grey Lambert walls lit only by a constant sky through one window (0.4 high, 0.5 wide, in
-/// the wall x = 4), seen from inside: the case the guide is for. Ten quads (the window wall in four pieces).
+/// tests/data/scenes/window_room.toml: a room of grey Lambert walls lit only by a constant sky through one small
+/// window, seen from inside — the case the guide is for.
 fn window_room() -> Scene {
-    let mut s = Scene { name: "window room".into(), ..Default::default() };
-    s.camera = Camera::look_at(Vec3::new(0.4, 1.6, 0.4), Vec3::new(3.0, 0.6, 3.0), Vec3::Y, 75.0);
-    s.materials.push(Material::lambert("wall", Vec3::splat(0.5)));
-    s.environment = mislab::scene::Environment::Constant(Vec3::ONE);
-    let mut quad = |corner: [f32; 3], edge_u: [f32; 3], edge_v: [f32; 3]| {
-        let (corner, edge_u, edge_v) = (Vec3::from(corner), Vec3::from(edge_u), Vec3::from(edge_v));
-        s.quads.push(Quad { corner, edge_u, edge_v, material: 0 });
-    };
-    quad([0.0, 0.0, 0.0], [0.0, 0.0, 4.0], [4.0, 0.0, 0.0]); // floor
-    quad([0.0, 2.5, 0.0], [4.0, 0.0, 0.0], [0.0, 0.0, 4.0]); // ceiling
-    quad([0.0, 0.0, 0.0], [0.0, 2.5, 0.0], [0.0, 0.0, 4.0]); // x = 0
-    quad([0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 2.5, 0.0]); // z = 0
-    quad([0.0, 0.0, 4.0], [0.0, 2.5, 0.0], [4.0, 0.0, 0.0]); // z = 4
-                                                             // x = 4, around the window y ∈ [1.2, 1.6], z ∈ [1.75, 2.25].
-    quad([4.0, 0.0, 0.0], [0.0, 0.0, 4.0], [0.0, 1.2, 0.0]);
-    quad([4.0, 1.6, 0.0], [0.0, 0.0, 4.0], [0.0, 0.9, 0.0]);
-    quad([4.0, 1.2, 0.0], [0.0, 0.0, 1.75], [0.0, 0.4, 0.0]);
-    quad([4.0, 1.2, 2.25], [0.0, 0.0, 1.75], [0.0, 0.4, 0.0]);
-    s
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/scenes/window_room.toml");
+    scene(path.to_str().expect("a UTF-8 path"))
 }
 
 /// The guided sky samples converge to what the cosine's do (per-pixel z-tests and the image mean against a cosine

@@ -463,71 +463,12 @@ fn camera_controls() {
     assert!((o.distance - 0.5 * d).abs() < 1e-4);
 }
 
-/// A 4 × 2.5 × 4 room lit by a constant sky through one window (the wall x = 4 in four pieces around it).
-const SKY_LIT_ROOM: &str = r#"
-[camera]
-position = [0.4, 1.6, 0.4]
-look_at = [3.0, 0.6, 3.0]
-vfov = 75
-[materials.wall]
-type = "lambert"
-reflectance = 0.5
-[environment]
-constant = 1
-[[quad]]
-corner = [0, 0, 0]
-edge_u = [0, 0, 4]
-edge_v = [4, 0, 0]
-material = "wall"
-[[quad]]
-corner = [0, 2.5, 0]
-edge_u = [4, 0, 0]
-edge_v = [0, 0, 4]
-material = "wall"
-[[quad]]
-corner = [0, 0, 0]
-edge_u = [0, 2.5, 0]
-edge_v = [0, 0, 4]
-material = "wall"
-[[quad]]
-corner = [0, 0, 0]
-edge_u = [4, 0, 0]
-edge_v = [0, 2.5, 0]
-material = "wall"
-[[quad]]
-corner = [0, 0, 4]
-edge_u = [0, 2.5, 0]
-edge_v = [4, 0, 0]
-material = "wall"
-[[quad]]
-corner = [4, 0, 0]
-edge_u = [0, 0, 4]
-edge_v = [0, 1, 0]
-material = "wall"
-[[quad]]
-corner = [4, 1.8, 0]
-edge_u = [0, 0, 4]
-edge_v = [0, 0.7, 0]
-material = "wall"
-[[quad]]
-corner = [4, 1, 0]
-edge_u = [0, 0, 1.5]
-edge_v = [0, 0.8, 0]
-material = "wall"
-[[quad]]
-corner = [4, 1, 2.5]
-edge_u = [0, 0, 1.5]
-edge_v = [0, 0.8, 0]
-material = "wall"
-"#;
-
-/// The viewer on a sky-lit room: under `env-sampling guided` (the default) a restart's first pass also learns the
+/// The viewer on a sky-lit room (tests/data/scenes/window_room.toml): under `env-sampling guided` (the default) a restart's first pass also learns the
 /// environment guide (`Renderer::ensure_guide`, called by the engine before a side's band); rendering goes on past
 /// it with no NaN/Inf, and after a settings change (here the mode, which resets the guide) likewise.
 #[test]
 fn a_sky_lit_room_learns_its_guide_and_renders_on() {
-    let path = std::env::temp_dir().join(format!("mislab-viewer-room-{}.toml", std::process::id()));
-    std::fs::write(&path, SKY_LIT_ROOM).unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/scenes/window_room.toml");
     let mut a = args();
     a.scene.scene = path.display().to_string();
     let (mut h, _one) = harness(a);
@@ -543,5 +484,4 @@ fn a_sky_lit_room_learns_its_guide_and_renders_on() {
         s.stats[0].settings.mode == Mode::Path && s.stats[0].spp >= 3
     });
     assert_eq!(h.state().engine().shared().stats[0].nonfinite_samples, 0, "NaN/Inf samples in path mode");
-    let _ = std::fs::remove_file(&path);
 }
