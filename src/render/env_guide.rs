@@ -145,9 +145,6 @@ pub fn bin_direction(b: usize, uv: Vec2) -> Vec3 {
     Vec3::new(r * phi.cos(), z, r * phi.sin())
 }
 
-/// Solid angle of one bin (the shader's GUIDE_BIN_SOLID_ANGLE).
-pub const BIN_SOLID_ANGLE: f32 = 4.0 * std::f32::consts::PI / BINS as f32;
-
 /// Words of the learning pass's counts: per slot its [`BINS`] bin counts, then per slot two tallies (shadow rays
 /// towards the sky, and those that reached it).
 pub fn counts_words(slots: usize) -> usize {
