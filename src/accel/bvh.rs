@@ -221,16 +221,19 @@ pub fn quad_aabb(q: &GpuQuad) -> Option<Aabb> {
     (finite3(b.min) && finite3(b.max)).then_some(b)
 }
 
-/// obvhs build settings: its "slow" preset's PLOC search (24 neighbours) and 20 % reinsertion, without spatial
-/// pre-splits (they duplicate references and need triangles), with leaves of at most 4 primitives collapsed by
-/// the SAH with traversal cost 1 (our node tests two boxes per fetch; an intersection costs about as much).
+/// obvhs build settings: its "slow" preset's PLOC search (24 neighbours), without spatial pre-splits (they
+/// duplicate references and need triangles), with leaves of at most 4 primitives collapsed by the SAH with
+/// traversal cost 1 (our node tests two boxes per fetch; an intersection costs about as much). Reinsertion
+/// (moving subtrees to where they lower the SAH) starts from every node, before and after the leaf collapse, not
+/// the preset's 20 %: the build takes 2.5–3× as long (1M triangles: 2.3 → 6.9 s) and the trees render 0.86–1.0× the
+/// time (docs/profile-bvh.md, "BVH quality").
 fn build_params() -> obvhs::BvhBuildParams {
     obvhs::BvhBuildParams {
         pre_split: false,
         ploc_search_distance: obvhs::ploc::PlocSearchDistance::High,
         search_depth_threshold: 2,
-        reinsertion_batch_ratio: 0.2,
-        post_collapse_reinsertion_batch_ratio_multiplier: 2.0,
+        reinsertion_batch_ratio: 1.0,
+        post_collapse_reinsertion_batch_ratio_multiplier: 1.0,
         sort_precision: obvhs::ploc::SortPrecision::U64,
         max_prims_per_leaf: MAX_LEAF_PRIMS,
         collapse_traversal_cost: 1.0,
