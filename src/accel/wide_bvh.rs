@@ -116,30 +116,6 @@ impl Child {
     }
 }
 
-/// The two children of a BVH2 node. An interior child whose whole subtree holds at most [`MAX_LEAF_PRIMS`]
-/// primitives becomes one leaf: in the 8-wide tree a node step (five vec4 loads, often for a node of only two
-/// small leaves) costs more than the one or two extra triangle tests of the merged leaf, and the tree gets smaller.
-fn children_of(tree: &Bvh2View, n: &GpuBvhNode) -> Vec<Child> {
-    let mut v = Vec::with_capacity(2);
-    for (lo, hi, first, count) in [(n.lmin, n.lmax, n.l_first, n.l_count), (n.rmin, n.rmax, n.r_first, n.r_count)] {
-        let bx = Aabb { min: lo.into(), max: hi.into() };
-        if count > 0 {
-            let mut refs = [0; MAX_LEAF_PRIMS as usize];
-            refs[..count as usize].copy_from_slice(&tree.prim_refs[first as usize..(first + count) as usize]);
-            v.push(Child::Leaf { refs, count, bx });
-        } else if first != EMPTY_CHILD {
-            if tree.subtree_prims[first as usize] <= MAX_LEAF_PRIMS {
-                let mut refs = [0; MAX_LEAF_PRIMS as usize];
-                let count = tree.gather(first, &mut refs, 0);
-                v.push(Child::Leaf { refs, count, bx });
-            } else {
-                v.push(Child::Interior { node: first, bx });
-            }
-        }
-    }
-    v
-}
-
 /// The BVH2 being collapsed, with the primitive count of every node's subtree.
 struct Bvh2View<'a> {
     nodes: &'a [GpuBvhNode],
@@ -186,33 +162,175 @@ impl<'a> Bvh2View<'a> {
     }
 }
 
-/// Up to eight children for one wide node: starting from a BVH2 node's two, the interior child with the largest
-/// surface area is replaced by its own children while there is room (SAH-greedy, as in the paper's simpler variant)
-/// and the leaves' primitives still fit the 24 hit bits.
-fn collapse(bvh2: &Bvh2View, root: &GpuBvhNode) -> Vec<Child> {
-    let mut kids = children_of(bvh2, root);
-    let prims = |k: &[Child]| k.iter().map(|c| if let Child::Leaf { count, .. } = c { *count } else { 0 }).sum::<u32>();
-    while kids.len() < WIDTH {
-        let mut best: Option<(usize, f64)> = None;
-        for (i, c) in kids.iter().enumerate() {
-            if let Child::Interior { node, bx } = c {
-                let grand = children_of(bvh2, &bvh2.nodes[*node as usize]);
-                let extra = prims(&grand);
-                if kids.len() - 1 + grand.len() <= WIDTH
-                    && prims(&kids) + extra <= MAX_NODE_PRIMS
-                    && best.is_none_or(|(_, a)| bx.half_area() > a)
-                {
-                    best = Some((i, bx.half_area()));
-                }
-            }
-        }
-        let Some((i, _)) = best else { break };
-        let Child::Interior { node, .. } = kids.swap_remove(i) else { unreachable!() };
-        kids.extend(children_of(bvh2, &bvh2.nodes[node as usize]));
-    }
-    kids
+/// SAH cost of a node step (Ylitie et al. 2017, §4.1)...
+const C_NODE: f64 = 1.0;
+/// ... and of one primitive test: on lavapipe a node step (three 32-byte loads, eight box tests) costs about two
+/// triangle tests (two loads and the watertight test). 0.3 and 1.0 rendered within 2 % of 0.5
+/// (docs/profile-bvh.md, "BVH quality").
+const C_PRIM: f64 = 0.5;
+
+/// One side of a BVH2 node, as the collapse sees it.
+#[derive(Clone, Copy)]
+enum Side {
+    Empty,
+    /// A BVH2 leaf: `prim_refs[first..first + count]`.
+    Leaf {
+        first: u32,
+        count: u32,
+        bx: Aabb,
+    },
+    /// A BVH2 interior node.
+    Node {
+        node: u32,
+        bx: Aabb,
+    },
 }
 
+/// Marks a slot count whose best form is the subtree as one child (a leaf or one wide node).
+const ONE_CHILD: u8 = u8::MAX;
+
+/// The SAH-optimal collapse of Ylitie et al. 2017 (§4.1), by dynamic programming over the BVH2: for every BVH2
+/// node n and j = 1..=8, `cost[n][j − 1]` is the least SAH cost of n's subtree as at most j children of a wide node
+/// — as one child (a leaf of its primitives, or a wide node of its own whose children cost `spread[n][7]`), or its
+/// two sides spread over the j slots. A subtree of at most [`MAX_LEAF_PRIMS`] primitives is always one leaf: in the
+/// 8-wide tree a node step (often for a node of only two small leaves) costs more than the one or two extra
+/// triangle tests of the merged leaf, and the tree gets smaller. (Until 2026-12-04 the collapse was greedy: the
+/// interior child of largest area opened while there was room; this renders in 0.92–0.99× its time,
+/// docs/profile-bvh.md, "BVH quality".)
+struct Collapse<'a> {
+    view: &'a Bvh2View<'a>,
+    /// Least cost of n's subtree in at most j slots.
+    cost: Vec<[f64; WIDTH]>,
+    /// `ONE_CHILD`, or the slots that go to n's left side (the rest to its right).
+    choice: Vec<[u8; WIDTH]>,
+    /// Whether n as one child is a leaf (else a wide node).
+    as_leaf: Vec<bool>,
+}
+
+impl<'a> Collapse<'a> {
+    fn sides(&self, n: u32) -> [Side; 2] {
+        let g = &self.view.nodes[n as usize];
+        [(g.lmin, g.lmax, g.l_first, g.l_count), (g.rmin, g.rmax, g.r_first, g.r_count)].map(
+            |(lo, hi, first, count)| {
+                let bx = Aabb { min: lo.into(), max: hi.into() };
+                if count > 0 {
+                    Side::Leaf { first, count, bx }
+                } else if first != EMPTY_CHILD {
+                    Side::Node { node: first, bx }
+                } else {
+                    Side::Empty
+                }
+            },
+        )
+    }
+
+    /// Least cost of a side in at most j ≥ 1 slots.
+    fn side_cost(&self, side: Side, j: usize) -> f64 {
+        match side {
+            Side::Empty => 0.0,
+            Side::Leaf { count, bx, .. } => bx.half_area() * count as f64 * C_PRIM,
+            Side::Node { node, .. } => self.cost[node as usize][j - 1],
+        }
+    }
+
+    /// The two sides of n spread over at most j slots: least cost and the left side's share.
+    fn spread(&self, n: u32, j: usize) -> (f64, u8) {
+        match self.sides(n) {
+            [Side::Empty, Side::Empty] => (0.0, 0),
+            [l, Side::Empty] => (self.side_cost(l, j), j as u8),
+            [Side::Empty, r] => (self.side_cost(r, j), 0),
+            [l, r] => (1..j)
+                .map(|k| (self.side_cost(l, k) + self.side_cost(r, j - k), k as u8))
+                .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a }),
+        }
+    }
+
+    fn new(view: &'a Bvh2View<'a>) -> Self {
+        let len = view.nodes.len();
+        let mut c = Collapse {
+            view,
+            cost: vec![[0.0; WIDTH]; len],
+            choice: vec![[ONE_CHILD; WIDTH]; len],
+            as_leaf: vec![false; len],
+        };
+        // Depth-first preorder: a reverse sweep sees every child before its parent.
+        for n in (0..len as u32).rev() {
+            let area = c.sides(n).iter().fold(Aabb::EMPTY, |a, s| a.union(&s.bx())).half_area();
+            let i = n as usize;
+            let prims = view.subtree_prims[i];
+            let one = if prims <= MAX_LEAF_PRIMS {
+                c.as_leaf[i] = true;
+                area * prims as f64 * C_PRIM
+            } else {
+                area * C_NODE + c.spread(n, WIDTH).0
+            };
+            for j in 1..=WIDTH {
+                let (spread, k) = if j > 1 && prims > MAX_LEAF_PRIMS { c.spread(n, j) } else { (f64::INFINITY, 0) };
+                let (cost, choice) = if spread < one { (spread, k) } else { (one, ONE_CHILD) };
+                c.cost[i][j - 1] = cost;
+                c.choice[i][j - 1] = choice;
+            }
+        }
+        c
+    }
+
+    /// Appends n's subtree in at most j slots to `out`, as the costs chose.
+    fn emit(&self, n: u32, j: usize, bx: Aabb, out: &mut Vec<Child>) {
+        let i = n as usize;
+        match self.choice[i][j - 1] {
+            ONE_CHILD if self.as_leaf[i] => {
+                let mut refs = [0; MAX_LEAF_PRIMS as usize];
+                let count = self.view.gather(n, &mut refs, 0);
+                out.push(Child::Leaf { refs, count, bx });
+            }
+            ONE_CHILD => out.push(Child::Interior { node: n, bx }),
+            k => self.emit_sides(n, j, k as usize, out),
+        }
+    }
+
+    /// Appends n's two sides, k slots for the left and j − k for the right, to `out`.
+    fn emit_sides(&self, n: u32, j: usize, k: usize, out: &mut Vec<Child>) {
+        let [l, r] = self.sides(n);
+        for (side, slots) in [(l, k), (r, j - k)] {
+            match side {
+                Side::Empty => {}
+                Side::Leaf { first, count, bx } => {
+                    let mut refs = [0; MAX_LEAF_PRIMS as usize];
+                    refs[..count as usize]
+                        .copy_from_slice(&self.view.prim_refs[first as usize..(first + count) as usize]);
+                    out.push(Child::Leaf { refs, count, bx });
+                }
+                Side::Node { node, bx } => self.emit(node, slots, bx, out),
+            }
+        }
+    }
+
+    /// The children of the wide node made from BVH2 node n: its sides spread over the eight slots — or over fewer
+    /// where the leaves' primitives would not fit the 24 hit bits (at most 4 a leaf, so 6 slots always fit).
+    fn children(&self, n: u32) -> Vec<Child> {
+        let prims =
+            |k: &[Child]| k.iter().map(|c| if let Child::Leaf { count, .. } = c { *count } else { 0 }).sum::<u32>();
+        let mut kids = Vec::with_capacity(WIDTH);
+        for j in (2..=WIDTH).rev() {
+            kids.clear();
+            let (_, k) = self.spread(n, j);
+            self.emit_sides(n, j, k as usize, &mut kids);
+            if prims(&kids) <= MAX_NODE_PRIMS {
+                break;
+            }
+        }
+        kids
+    }
+}
+
+impl Side {
+    fn bx(&self) -> Aabb {
+        match *self {
+            Side::Empty => Aabb::EMPTY,
+            Side::Leaf { bx, .. } | Side::Node { bx, .. } => bx,
+        }
+    }
+}
 /// Slot of each child: bit k set = the child lies on the + side of axis k (by centroid, against the parent's).
 /// Greedy on the score Σₖ ±(cₖ − pₖ): the best-matching (child, slot) pair first.
 fn assign_slots(kids: &[Child]) -> [Option<usize>; WIDTH] {
@@ -249,6 +367,7 @@ pub fn widen(bvh: &Bvh) -> Option<Bvh> {
     let mut refs: Vec<u32> = Vec::with_capacity(bvh.prim_refs.len());
     // (BVH2 node, wide node index, depth)
     let view = Bvh2View::new(bvh);
+    let collapse = Collapse::new(&view);
     let mut todo = vec![(0u32, 0usize, 1usize)];
     let mut depth = 1;
     while let Some((src, dst, d)) = todo.pop() {
@@ -256,7 +375,7 @@ pub fn widen(bvh: &Bvh) -> Option<Bvh> {
         if depth > MAX_WIDE_DEPTH {
             return None;
         }
-        let kids = collapse(&view, &bvh.nodes[src as usize]);
+        let kids = collapse.children(src);
         let slots = assign_slots(&kids);
         let parent = kids.iter().fold(Aabb::EMPTY, |a, c| a.union(&c.bx()));
         let mut node = GpuWideNode::default();
@@ -338,4 +457,113 @@ pub fn depth(wide: &[GpuWideNode]) -> usize {
         }
     }
     max
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::bvh;
+
+    /// Triangles scattered in clusters of varied size, so that the BVH2 has unbalanced subtrees.
+    fn scattered(n: usize) -> Vec<[Vec3; 3]> {
+        let mut state = 0x9e3779b97f4a7c15u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|i| {
+                let c = Vec3::new((i % 7) as f32 * 3.0, (i % 5) as f32 * 0.5, (i % 3) as f32 * 8.0);
+                let p = c + Vec3::new(next(), next(), next()) * (1 + i % 4) as f32;
+                [p, p + Vec3::new(next(), 0.1, 0.0), p + Vec3::new(0.0, next(), 0.2)]
+            })
+            .collect()
+    }
+
+    /// The SAH cost of the collapsed wide tree as built: C_NODE · area for every wide node below the root's
+    /// children, C_PRIM · area · count for every leaf, from the same BVH2 boxes the collapse used.
+    fn emitted_cost(c: &Collapse, n: u32) -> f64 {
+        c.children(n)
+            .iter()
+            .map(|k| match *k {
+                Child::Leaf { count, bx, .. } => bx.half_area() * count as f64 * C_PRIM,
+                Child::Interior { node, bx } => bx.half_area() * C_NODE + emitted_cost(c, node),
+            })
+            .sum()
+    }
+
+    #[test]
+    fn collapse_builds_the_tree_its_costs_describe() {
+        let tris = scattered(600);
+        let b2 = bvh::build(&tris, &[], &[]);
+        let view = Bvh2View::new(&b2);
+        let c = Collapse::new(&view);
+        for n in 0..b2.nodes.len() {
+            // More slots never cost more, and a subtree of few primitives is one leaf whatever the slots.
+            assert!(c.cost[n].windows(2).all(|w| w[1] <= w[0]), "node {n}: {:?}", c.cost[n]);
+            if view.subtree_prims[n] <= MAX_LEAF_PRIMS {
+                assert!(c.as_leaf[n] && c.choice[n].iter().all(|&k| k == ONE_CHILD));
+            }
+        }
+        let (optimum, _) = c.spread(0, WIDTH);
+        let built = emitted_cost(&c, 0);
+        assert!((built - optimum).abs() <= 1e-9 * optimum, "built {built} against the optimum {optimum}");
+        // No wide node holds more leaf primitives than its hit bits, and every reference lands in one leaf.
+        let wide = widen(&b2).expect("shallow enough");
+        let mut refs = wide.prim_refs.clone();
+        refs.sort_unstable();
+        assert_eq!(refs, (0..tris.len() as u32).collect::<Vec<_>>());
+    }
+
+    /// Against an exhaustive search: every wide tree the BVH2 allows (each wide node's children a cut of its
+    /// subtree of at most eight units, a unit a leaf of at most four primitives or a wide node of its own).
+    #[test]
+    fn collapse_is_optimal_on_a_small_tree() {
+        fn unit_cost(c: &Collapse, s: Side) -> f64 {
+            match s {
+                Side::Empty => 0.0,
+                Side::Leaf { count, bx, .. } => bx.half_area() * count as f64 * C_PRIM,
+                Side::Node { node, bx } if c.view.subtree_prims[node as usize] <= MAX_LEAF_PRIMS => {
+                    bx.half_area() * c.view.subtree_prims[node as usize] as f64 * C_PRIM
+                }
+                Side::Node { node, bx } => bx.half_area() * C_NODE + best(c, node),
+            }
+        }
+        // Every cut of a side's subtree into at most eight units, as lists of units.
+        fn cuts(c: &Collapse, s: Side) -> Vec<Vec<Side>> {
+            let mut out = vec![vec![s]];
+            if let Side::Node { node, .. } = s {
+                if c.view.subtree_prims[node as usize] > MAX_LEAF_PRIMS {
+                    out.extend(spreads(c, node));
+                }
+            }
+            out
+        }
+        fn spreads(c: &Collapse, n: u32) -> Vec<Vec<Side>> {
+            let [l, r] = c.sides(n);
+            let mut out = Vec::new();
+            for a in cuts(c, l) {
+                for b in cuts(c, r) {
+                    let u: Vec<Side> = a.iter().chain(&b).copied().filter(|s| !matches!(s, Side::Empty)).collect();
+                    if u.len() <= WIDTH {
+                        out.push(u);
+                    }
+                }
+            }
+            out
+        }
+        // The least cost of the children of a wide node made from BVH2 node n.
+        fn best(c: &Collapse, n: u32) -> f64 {
+            spreads(c, n).iter().map(|u| u.iter().map(|&s| unit_cost(c, s)).sum::<f64>()).fold(f64::INFINITY, f64::min)
+        }
+        for (n, seed_shift) in [(40, 0), (70, 3)] {
+            let tris: Vec<_> = scattered(n + seed_shift).into_iter().skip(seed_shift).collect();
+            let b2 = bvh::build(&tris, &[], &[]);
+            let view = Bvh2View::new(&b2);
+            let c = Collapse::new(&view);
+            let (dp, _) = c.spread(0, WIDTH);
+            let exhaustive = best(&c, 0);
+            assert!((dp - exhaustive).abs() <= 1e-9 * exhaustive, "{n} triangles: {dp} against {exhaustive}");
+        }
+    }
 }
