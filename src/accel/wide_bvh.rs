@@ -186,13 +186,22 @@ enum Side {
     },
 }
 
+impl Side {
+    fn bx(&self) -> Aabb {
+        match *self {
+            Side::Empty => Aabb::EMPTY,
+            Side::Leaf { bx, .. } | Side::Node { bx, .. } => bx,
+        }
+    }
+}
+
 /// Marks a slot count whose best form is the subtree as one child (a leaf or one wide node).
 const ONE_CHILD: u8 = u8::MAX;
 
 /// The SAH-optimal collapse of Ylitie et al. 2017 (§4.1), by dynamic programming over the BVH2: for every BVH2
 /// node n and j = 1..=8, `cost[n][j − 1]` is the least SAH cost of n's subtree as at most j children of a wide node
-/// — as one child (a leaf of its primitives, or a wide node of its own whose children cost `spread[n][7]`), or its
-/// two sides spread over the j slots. A subtree of at most [`MAX_LEAF_PRIMS`] primitives is always one leaf: in the
+/// — as one child (a leaf of its primitives, or a wide node of its own whose children are its sides spread over all
+/// eight slots), or its two sides spread over the j slots. A subtree of at most [`MAX_LEAF_PRIMS`] primitives is always one leaf: in the
 /// 8-wide tree a node step (often for a node of only two small leaves) costs more than the one or two extra
 /// triangle tests of the merged leaf, and the tree gets smaller. (Until 2026-12-04 the collapse was greedy: the
 /// interior child of largest area opened while there was room; this renders in 0.92–0.99× its time,
@@ -323,14 +332,6 @@ impl<'a> Collapse<'a> {
     }
 }
 
-impl Side {
-    fn bx(&self) -> Aabb {
-        match *self {
-            Side::Empty => Aabb::EMPTY,
-            Side::Leaf { bx, .. } | Side::Node { bx, .. } => bx,
-        }
-    }
-}
 /// Slot of each child: bit k set = the child lies on the + side of axis k (by centroid, against the parent's).
 /// Greedy on the score Σₖ ±(cₖ − pₖ): the best-matching (child, slot) pair first.
 fn assign_slots(kids: &[Child]) -> [Option<usize>; WIDTH] {
