@@ -201,11 +201,10 @@ const ONE_CHILD: u8 = u8::MAX;
 /// The SAH-optimal collapse of Ylitie et al. 2017 (§4.1), by dynamic programming over the BVH2: for every BVH2
 /// node n and j = 1..=8, `cost[n][j − 1]` is the least SAH cost of n's subtree as at most j children of a wide node
 /// — as one child (a leaf of its primitives, or a wide node of its own whose children are its sides spread over all
-/// eight slots), or its two sides spread over the j slots. A subtree of at most [`MAX_LEAF_PRIMS`] primitives is always one leaf: in the
-/// 8-wide tree a node step (often for a node of only two small leaves) costs more than the one or two extra
-/// triangle tests of the merged leaf, and the tree gets smaller. (Until 2026-12-04 the collapse was greedy: the
-/// interior child of largest area opened while there was room; this renders in 0.92–0.99× its time,
-/// docs/profile-bvh.md, "BVH quality".)
+/// eight slots), or its two sides spread over the j slots; a leaf holds at most [`MAX_LEAF_PRIMS`] primitives.
+/// (Until 2026-12-04 the collapse was greedy — the interior child of largest area opened while there was room,
+/// and every subtree of at most 4 primitives merged into one leaf; the costs decide both now, and the trees render
+/// in 0.84–0.99× the time, docs/profile-bvh.md, "BVH quality".)
 struct Collapse<'a> {
     view: &'a Bvh2View<'a>,
     /// Least cost of n's subtree in at most j slots.
@@ -267,14 +266,12 @@ impl<'a> Collapse<'a> {
             let area = c.sides(n).iter().fold(Aabb::EMPTY, |a, s| a.union(&s.bx())).half_area();
             let i = n as usize;
             let prims = view.subtree_prims[i];
-            let one = if prims <= MAX_LEAF_PRIMS {
-                c.as_leaf[i] = true;
-                area * prims as f64 * C_PRIM
-            } else {
-                area * C_NODE + c.spread(n, WIDTH).0
-            };
+            let as_node = area * C_NODE + c.spread(n, WIDTH).0;
+            let as_leaf = area * prims as f64 * C_PRIM;
+            c.as_leaf[i] = prims <= MAX_LEAF_PRIMS && as_leaf <= as_node;
+            let one = if c.as_leaf[i] { as_leaf } else { as_node };
             for j in 1..=WIDTH {
-                let (spread, k) = if j > 1 && prims > MAX_LEAF_PRIMS { c.spread(n, j) } else { (f64::INFINITY, 0) };
+                let (spread, k) = if j > 1 { c.spread(n, j) } else { (f64::INFINITY, 0) };
                 let (cost, choice) = if spread < one { (spread, k) } else { (one, ONE_CHILD) };
                 c.cost[i][j - 1] = cost;
                 c.choice[i][j - 1] = choice;
@@ -500,11 +497,9 @@ mod tests {
         let view = Bvh2View::new(&b2);
         let c = Collapse::new(&view);
         for n in 0..b2.nodes.len() {
-            // More slots never cost more, and a subtree of few primitives is one leaf whatever the slots.
+            // More slots never cost more; only a subtree that fits a leaf is one.
             assert!(c.cost[n].windows(2).all(|w| w[1] <= w[0]), "node {n}: {:?}", c.cost[n]);
-            if view.subtree_prims[n] <= MAX_LEAF_PRIMS {
-                assert!(c.as_leaf[n] && c.choice[n].iter().all(|&k| k == ONE_CHILD));
-            }
+            assert!(!c.as_leaf[n] || view.subtree_prims[n] <= MAX_LEAF_PRIMS);
         }
         let (optimum, _) = c.spread(0, WIDTH);
         let built = emitted_cost(&c, 0);
@@ -520,32 +515,36 @@ mod tests {
     /// subtree of at most eight units, a unit a leaf of at most four primitives or a wide node of its own).
     #[test]
     fn collapse_is_optimal_on_a_small_tree() {
-        fn unit_cost(c: &Collapse, s: Side) -> f64 {
+        /// A unit of a cut: a side as one leaf, or (`wide`) a BVH2 interior node as a wide node.
+        type Unit = (Side, bool);
+        fn unit_cost(c: &Collapse, (s, wide): Unit) -> f64 {
             match s {
                 Side::Empty => 0.0,
                 Side::Leaf { count, bx, .. } => bx.half_area() * count as f64 * C_PRIM,
-                Side::Node { node, bx } if c.view.subtree_prims[node as usize] <= MAX_LEAF_PRIMS => {
-                    bx.half_area() * c.view.subtree_prims[node as usize] as f64 * C_PRIM
-                }
-                Side::Node { node, bx } => bx.half_area() * C_NODE + best(c, node),
+                Side::Node { node, bx } if wide => bx.half_area() * C_NODE + best(c, node),
+                Side::Node { node, bx } => bx.half_area() * c.view.subtree_prims[node as usize] as f64 * C_PRIM,
             }
         }
-        // Every cut of a side's subtree into at most eight units, as lists of units.
-        fn cuts(c: &Collapse, s: Side) -> Vec<Vec<Side>> {
-            let mut out = vec![vec![s]];
-            if let Side::Node { node, .. } = s {
-                if c.view.subtree_prims[node as usize] > MAX_LEAF_PRIMS {
+        // Every cut of a side's subtree into units.
+        fn cuts(c: &Collapse, s: Side) -> Vec<Vec<Unit>> {
+            match s {
+                Side::Node { node, .. } => {
+                    let mut out = vec![vec![(s, true)]];
+                    if c.view.subtree_prims[node as usize] <= MAX_LEAF_PRIMS {
+                        out.push(vec![(s, false)]);
+                    }
                     out.extend(spreads(c, node));
+                    out
                 }
+                _ => vec![vec![(s, false)]],
             }
-            out
         }
-        fn spreads(c: &Collapse, n: u32) -> Vec<Vec<Side>> {
+        fn spreads(c: &Collapse, n: u32) -> Vec<Vec<Unit>> {
             let [l, r] = c.sides(n);
             let mut out = Vec::new();
             for a in cuts(c, l) {
                 for b in cuts(c, r) {
-                    let u: Vec<Side> = a.iter().chain(&b).copied().filter(|s| !matches!(s, Side::Empty)).collect();
+                    let u: Vec<Unit> = a.iter().chain(&b).copied().filter(|u| !matches!(u.0, Side::Empty)).collect();
                     if u.len() <= WIDTH {
                         out.push(u);
                     }
@@ -557,8 +556,8 @@ mod tests {
         fn best(c: &Collapse, n: u32) -> f64 {
             spreads(c, n).iter().map(|u| u.iter().map(|&s| unit_cost(c, s)).sum::<f64>()).fold(f64::INFINITY, f64::min)
         }
-        for (n, seed_shift) in [(40, 0), (70, 3)] {
-            let tris: Vec<_> = scattered(n + seed_shift).into_iter().skip(seed_shift).collect();
+        for (n, skip) in [(12, 0), (18, 3)] {
+            let tris: Vec<_> = scattered(n + skip).into_iter().skip(skip).collect();
             let b2 = bvh::build(&tris, &[], &[]);
             let view = Bvh2View::new(&b2);
             let c = Collapse::new(&view);
