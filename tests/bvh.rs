@@ -90,11 +90,15 @@ impl Geometry {
     fn scene(&self) -> Scene<'_> {
         Scene { tris: &self.tris, spheres: &self.spheres, quads: &self.quads }
     }
+    /// The tree the renderer builds (large triangles pre-split; the geometry here has no emitters).
     fn build(&self) -> Bvh {
-        bvh::build(&self.tris, &self.spheres, &self.quads)
+        self.build_with(true)
+    }
+    fn build_with(&self, presplit: bool) -> Bvh {
+        bvh::build(&self.tris, &self.spheres, &self.quads, split(presplit))
     }
     fn build_wide(&self) -> Bvh {
-        bvh::build_wide(&self.tris, &self.spheres, &self.quads)
+        bvh::build_wide(&self.tris, &self.spheres, &self.quads, split(true))
     }
 }
 
@@ -467,6 +471,14 @@ fn is_included(g: &Geometry, p: u32) -> bool {
     }
 }
 
+fn split(presplit: bool) -> bvh::Presplit<'static> {
+    if presplit {
+        bvh::Presplit::Large { keep_whole: &[] }
+    } else {
+        bvh::Presplit::Off
+    }
+}
+
 /// Random triangles, spheres and quads, a small grid mesh (shared edges and vertices), and excluded junk
 /// (zero-area and non-finite primitives).
 fn soup(seed: u64) -> Geometry {
@@ -570,13 +582,50 @@ fn prim_box(g: &Geometry, p: u32) -> bvh::Aabb {
     .expect("an excluded primitive is in the tree")
 }
 
-/// Every included primitive is referenced once, every box holds what is below it, leaves are small and the depth
-/// fits the GPU stack.
+/// Checks the leaves found in a tree, as (leaf box, primitive reference) pairs: a sphere or quad is in exactly
+/// one leaf whose box holds it; a triangle is in at least one (pre-split triangles, `accel::presplit`, are in
+/// several), never twice in one leaf (`leaf` numbers the leaves), and every point of it lies in one of its leaves'
+/// boxes (sampled on a grid of barycentric points, corners and edges included, in f64 with a tolerance far below
+/// any gap a wrong piece would leave).
+fn check_leaf_cover(g: &Geometry, found: &[(bvh::Aabb, u32, usize)]) {
+    let mut by_prim: std::collections::HashMap<u32, Vec<(bvh::Aabb, usize)>> = Default::default();
+    for &(bx, p, leaf) in found {
+        by_prim.entry(p).or_default().push((bx, leaf));
+    }
+    for (&p, leaves) in &by_prim {
+        let i = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
+        if p >> 30 != PRIM_TRIANGLE {
+            assert_eq!(leaves.len(), 1, "primitive {p:#x} is in {} leaves", leaves.len());
+            assert!(leaves[0].0.contains(&prim_box(g, p)), "leaf box does not hold primitive {p:#x}");
+            continue;
+        }
+        let mut ids: Vec<usize> = leaves.iter().map(|l| l.1).collect();
+        ids.sort_unstable();
+        assert!(ids.windows(2).all(|w| w[0] != w[1]), "triangle {i} twice in one leaf");
+        let t = g.tris[i].map(|v| v.as_dvec3());
+        let whole = prim_box(g, p);
+        let tol = 1e-6 * (whole.max - whole.min).max_element() as f64;
+        let n = 12;
+        for a in 0..=n {
+            for c in 0..=(n - a) {
+                let (u, w) = (a as f64 / n as f64, c as f64 / n as f64);
+                let q = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * w;
+                let inside =
+                    |b: &bvh::Aabb| (b.min.as_dvec3() - tol).cmple(q).all() && (b.max.as_dvec3() + tol).cmpge(q).all();
+                assert!(leaves.iter().any(|l| inside(&l.0)), "point {q} of triangle {i} is in none of its leaves");
+            }
+        }
+    }
+}
+
+/// Every included primitive is referenced (each reference slot in exactly one leaf), every box holds what is
+/// below it, leaves are small and cover their primitives ([`check_leaf_cover`]), and the depth fits the GPU stack.
 fn check_structure(g: &Geometry, b: &Bvh) {
     assert!(!b.nodes.is_empty());
     assert!(b.depth() <= bvh::BVH_STACK_SIZE, "depth {} exceeds the traversal stack", b.depth());
     let mut seen = vec![0u32; b.prim_refs.len()];
     let mut visited = vec![false; b.nodes.len()];
+    let mut found = Vec::new();
     let mut stack = vec![0usize];
     while let Some(n) = stack.pop() {
         assert!(!std::mem::replace(&mut visited[n], true), "node {n} reached twice");
@@ -589,9 +638,7 @@ fn check_structure(g: &Geometry, b: &Bvh) {
                 assert!(count <= bvh::MAX_LEAF_PRIMS || b.prim_refs.len() <= bvh::MAX_LEAF_PRIMS as usize);
                 for k in first..first + count {
                     seen[k as usize] += 1;
-                    let p = b.prim_refs[k as usize];
-                    let pb = prim_box(g, p);
-                    assert!(bx.contains(&pb), "leaf box does not hold primitive {p:#x}");
+                    found.push((bx, b.prim_refs[k as usize], first as usize));
                 }
             } else if first != EMPTY_CHILD {
                 let c = b.nodes[first as usize];
@@ -606,11 +653,12 @@ fn check_structure(g: &Geometry, b: &Bvh) {
     }
     assert!(visited.iter().all(|&v| v), "unreachable nodes");
     assert!(seen.iter().all(|&c| c == 1), "a primitive reference is not in exactly one leaf");
+    check_leaf_cover(g, &found);
     let mut refs = b.prim_refs.clone();
     refs.sort_unstable();
     refs.dedup();
     let included = reference::all_prims(&g.scene()).filter(|&p| is_included(g, p)).count();
-    assert_eq!(refs.len(), included, "every included primitive once");
+    assert_eq!(refs.len(), included, "every included primitive at least once");
     assert!(b.sah_cost.is_finite() && b.sah_cost >= 0.0);
 }
 
@@ -619,12 +667,20 @@ fn build_invariants() {
     let g = soup(1);
     let b = g.build();
     check_structure(&g, &b);
-    assert_eq!(b.prim_refs.len(), 3000 + 24 * 24 * 2 + 30 + 100 + 130, "junk must be excluded");
+    let mut distinct = b.prim_refs.clone();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert_eq!(distinct.len(), 3000 + 24 * 24 * 2 + 30 + 100 + 130, "junk must be excluded");
+    let unsplit = g.build_with(false);
+    check_structure(&g, &unsplit);
     eprintln!(
-        "soup: {} nodes, depth {}, SAH {:.1}, {:.1} bytes/triangle",
+        "soup: {} references ({} unsplit), {} nodes, depth {}, SAH {:.1} ({:.1} unsplit), {:.1} bytes/triangle",
+        b.prim_refs.len(),
+        unsplit.prim_refs.len(),
         b.node_count(),
         b.depth(),
         b.sah_cost,
+        unsplit.sah_cost,
         b.bytes_per_triangle()
     );
 }
@@ -640,9 +696,17 @@ fn leaf_order_makes_triangle_refs_the_identity() {
     assert!(b.prim_refs.iter().enumerate().all(|(j, &r)| r == j as u32), "prim_refs[j] == j");
     let mut seen = vec![false; g.tris.len()];
     order.iter().for_each(|&o| seen[o as usize] = true);
-    assert!(order.len() == g.tris.len() && seen.iter().all(|&s| s), "order is a permutation");
-    let permuted = Geometry { tris: order.iter().map(|&o| g.tris[o as usize]).collect(), ..g };
-    check_structure(&permuted, &b);
+    assert!(seen.iter().all(|&s| s), "order holds every triangle");
+    assert!(order.len() > g.tris.len(), "some of the helmet's triangles are pre-split (copies in the order)");
+    let first = mislab::accel::bvh::first_copies(&order);
+    for (new, &old) in order.iter().enumerate() {
+        let f = first[new] as usize;
+        assert!(f <= new && order[f] == old && !order[..f].contains(&old), "first copy of triangle {old}");
+    }
+    // The renumbered tree is the same tree: read back through `order`, its references name the same triangles.
+    let mut back = b.clone();
+    back.prim_refs.iter_mut().for_each(|r| *r = order[*r as usize]);
+    check_structure(&g, &back);
     // Mixed kinds: triangle references are rewritten, the others kept.
     let soup = soup(2);
     let mut b = soup.build();
@@ -1071,61 +1135,90 @@ fn gpu_wide_traversal_finds_axis_aligned_corners_far_from_the_origin() {
 // ---------------------------------------------------------------------------------------------------------------
 // The 8-wide compressed BVH (src/accel/wide_bvh.rs, shaders/bvh_wide.wgsl)
 
-/// The wide tree references every included primitive once, each decoded (quantised) child box contains the exact
-/// box of everything below it, leaves fit the 24 primitive bits, interior children follow `child_base` in slot
-/// order, and the depth fits the traversal stack.
-fn check_wide_structure(g: &Geometry, b: &Bvh) {
+/// The wide tree references every included primitive (each reference slot in exactly one leaf), each decoded
+/// (quantised) child box contains the exact box of everything below it, leaves fit the 24 primitive bits and cover
+/// their primitives ([`check_leaf_cover`]), interior children follow `child_base` in slot order, and the depth fits
+/// the traversal stack. A pre-split triangle's piece is known only by its leaf's box, so a triangle counts below a
+/// leaf by the box of one of its pieces (the split is deterministic: `pieces` repeats it) that the leaf's decoded
+/// box holds.
+fn check_wide_structure(g: &Geometry, b: &Bvh, presplit: bool) {
+    use mislab::accel::presplit::{self, Piece};
     use mislab::accel::wide_bvh::{self, WideChild, MAX_NODE_PRIMS, MAX_WIDE_DEPTH, WIDTH};
     assert!(!b.wide.is_empty(), "not a wide tree");
     assert!(wide_bvh::depth(&b.wide) <= MAX_WIDE_DEPTH, "wide depth {}", wide_bvh::depth(&b.wide));
-    let prim_box = |p: u32| prim_box(g, p);
-    let mut seen = vec![0u32; b.prim_refs.len()];
-    let mut visited = vec![false; b.wide.len()];
+    let whole: Vec<Piece> = (0..g.tris.len() as u32)
+        .filter_map(|t| bvh::triangle_aabb(&g.tris[t as usize]).map(|bx| Piece { tri: t, bx }))
+        .collect();
+    let budget = if presplit { (presplit::BUDGET * whole.len() as f64) as usize } else { 0 };
+    let mut pieces: Vec<Vec<bvh::Aabb>> = vec![Vec::new(); g.tris.len()];
+    presplit::split(&whole, &g.tris, budget).iter().for_each(|p| pieces[p.tri as usize].push(p.bx));
+    struct Walk<'a> {
+        g: &'a Geometry,
+        b: &'a Bvh,
+        pieces: Vec<Vec<bvh::Aabb>>,
+        seen: Vec<u32>,
+        visited: Vec<bool>,
+        found: Vec<(bvh::Aabb, u32, usize)>,
+    }
     // Exact box and primitive count of node n's subtree, checking its children's decoded boxes on the way.
-    fn subtree(
-        n: usize,
-        b: &Bvh,
-        seen: &mut [u32],
-        visited: &mut [bool],
-        prim_box: &dyn Fn(u32) -> bvh::Aabb,
-    ) -> (bvh::Aabb, u32) {
-        assert!(!std::mem::replace(&mut visited[n], true), "wide node {n} reached twice");
-        let node = b.wide[n];
+    fn subtree(n: usize, w: &mut Walk) -> (bvh::Aabb, u32) {
+        assert!(!std::mem::replace(&mut w.visited[n], true), "wide node {n} reached twice");
+        let node = w.b.wide[n];
         let (mut total, mut prims, mut interior) = (bvh::Aabb::EMPTY, 0, 0);
         for i in 0..WIDTH {
+            let decoded = node.child_box(i);
             let (exact, count) = match node.child(i) {
                 WideChild::Empty => continue,
                 WideChild::Interior(c) => {
                     assert_eq!(c, node.links[0] + interior, "interior children in slot order");
                     interior += 1;
                     // (The collapse may keep a node over as few as two primitives where the SAH says so.)
-                    let (bx, count) = subtree(c as usize, b, seen, visited, prim_box);
+                    let (bx, count) = subtree(c as usize, w);
                     assert!(count >= 2, "node {n} slot {i}: a node over only {count} primitive(s)");
                     (bx, count)
                 }
                 WideChild::Leaf { first, count } => {
                     assert!((1..=4).contains(&count) && first - node.links[1] + count <= MAX_NODE_PRIMS);
                     let bx = (first..first + count).fold(bvh::Aabb::EMPTY, |a, k| {
-                        seen[k as usize] += 1;
-                        a.union(&prim_box(b.prim_refs[k as usize]))
+                        w.seen[k as usize] += 1;
+                        let p = w.b.prim_refs[k as usize];
+                        w.found.push((decoded, p, first as usize));
+                        let part = if p >> 30 == PRIM_TRIANGLE {
+                            let t = (p & mislab::gpu::types::PRIM_INDEX_MASK) as usize;
+                            *w.pieces[t].iter().find(|bx| decoded.contains(bx)).unwrap_or_else(|| {
+                                panic!("node {n} slot {i}: no piece of triangle {t} fits the leaf's box")
+                            })
+                        } else {
+                            prim_box(w.g, p)
+                        };
+                        a.union(&part)
                     });
                     (bx, count)
                 }
             };
-            assert!(node.child_box(i).contains(&exact), "node {n} slot {i}: quantised box does not hold its child");
+            assert!(decoded.contains(&exact), "node {n} slot {i}: quantised box does not hold its child");
             total = total.union(&exact);
             prims += count;
         }
         (total, prims)
     }
-    subtree(0, b, &mut seen, &mut visited, &prim_box);
-    assert!(visited.iter().all(|&v| v), "unreachable wide nodes");
-    assert!(seen.iter().all(|&c| c == 1), "a primitive reference is not in exactly one leaf");
+    let mut w = Walk {
+        g,
+        b,
+        pieces,
+        seen: vec![0u32; b.prim_refs.len()],
+        visited: vec![false; b.wide.len()],
+        found: Vec::new(),
+    };
+    subtree(0, &mut w);
+    assert!(w.visited.iter().all(|&v| v), "unreachable wide nodes");
+    assert!(w.seen.iter().all(|&c| c == 1), "a primitive reference is not in exactly one leaf");
+    check_leaf_cover(g, &w.found);
     let mut refs = b.prim_refs.clone();
     refs.sort_unstable();
     refs.dedup();
     let included = reference::all_prims(&g.scene()).filter(|&p| is_included(g, p)).count();
-    assert_eq!(refs.len(), included, "every included primitive once");
+    assert_eq!(refs.len(), included, "every included primitive at least once");
 }
 
 #[test]
@@ -1154,7 +1247,7 @@ fn wide_build_invariants() {
     ];
     for (name, g) in cases {
         let b = g.build_wide();
-        check_wide_structure(&g, &b);
+        check_wide_structure(&g, &b, true);
         eprintln!(
             "{name}: {} wide nodes, depth {}, {:.1} bytes/triangle",
             b.wide.len(),

@@ -19,6 +19,7 @@ use std::time::Instant;
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3, Vec3A};
 
+use crate::accel::presplit::{self, Piece};
 use crate::accel::wide_bvh::GpuWideNode;
 use crate::gpu::types::{
     make_prim, GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE, PRIM_TRIANGLE,
@@ -103,30 +104,32 @@ impl Bvh {
     }
 }
 
-/// Renumbers the triangles in the order the leaves reference them. Returns `order` with `order[new] = old` over
-/// all `tri_count` triangles (those the tree excludes, degenerate ones, go last): the caller permutes every
-/// per-triangle array by it. In a triangle-only scene `prim_refs[j] == j` afterwards, so traversal reads a leaf's
-/// triangles directly (`shaders/bvh.wgsl`: three vertex loads per test instead of four); in mixed scenes the
-/// triangle references are rewritten to the new indices.
+/// Renumbers the triangles in the order the leaves reference them, one new triangle per reference: a pre-split
+/// triangle ([`crate::accel::presplit`]) referenced from several leaves becomes as many copies. Returns `order`
+/// with `order[new] = old`: every reference's triangle, then those the tree excludes (degenerate ones); each old
+/// triangle appears at least once, and its first copy comes first. The caller permutes every per-triangle array by
+/// it. In a triangle-only scene `prim_refs[j] == j` afterwards, so traversal reads a leaf's triangles directly
+/// (`shaders/bvh.wgsl`: three vertex loads per test instead of four); in mixed scenes the triangle references are
+/// rewritten to the new indices.
 pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
-    let mut new_of_old = vec![INVALID; tri_count];
+    let mut referenced = vec![false; tri_count];
     let mut order = Vec::with_capacity(tri_count);
     for r in bvh.prim_refs.iter_mut() {
         if *r >> PRIM_KIND_SHIFT == PRIM_TRIANGLE {
             let old = (*r & PRIM_INDEX_MASK) as usize;
-            if new_of_old[old] == INVALID {
-                new_of_old[old] = order.len() as u32;
-                order.push(old as u32);
-            }
-            *r = make_prim(PRIM_TRIANGLE, new_of_old[old]);
-        }
-    }
-    for (old, n) in new_of_old.iter().enumerate() {
-        if *n == INVALID {
+            referenced[old] = true;
+            *r = make_prim(PRIM_TRIANGLE, order.len() as u32);
             order.push(old as u32);
         }
     }
+    order.extend((0..tri_count as u32).filter(|&old| !referenced[old as usize]));
     order
+}
+
+/// For each triangle of `order` ([`into_leaf_order`]), the new index of its first copy.
+pub fn first_copies(order: &[u32]) -> Vec<u32> {
+    let mut first = std::collections::HashMap::with_capacity(order.len());
+    order.iter().enumerate().map(|(new, &old)| *first.entry(old).or_insert(new as u32)).collect()
 }
 
 /// An axis-aligned box (f32, as uploaded).
@@ -250,24 +253,42 @@ struct TmpNode {
     count: u32,
 }
 
+/// Which triangles [`build`] may reference in pieces ([`crate::accel::presplit`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Presplit<'a> {
+    /// None: one reference per triangle.
+    Off,
+    /// The large ones, except where `keep_whole[i]` is true (emitters: a shadow ray towards a point on an
+    /// emissive triangle skips that triangle by its index, which a copy would not have). `&[]`: any.
+    Large { keep_whole: &'a [bool] },
+}
+
 /// Builds the BVH over all primitives. Triangles are given by their three vertices (the same values, and order,
 /// as in the `tri_verts` buffer); excluded primitives (see [`triangle_aabb`], [`sphere_aabb`], [`quad_aabb`]) are
-/// not in the tree and can never be hit. Panics if a kind has more than 2^30 primitives.
-pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad]) -> Bvh {
-    build_with(tri_verts, spheres, quads, false)
+/// not in the tree and can never be hit. With [`Presplit::Large`], large triangles are referenced in pieces
+/// (`MISLAB_PRESPLIT=0` turns it off for A/B runs): a triangle may then be in several leaves, never twice in one.
+/// Panics if a kind has more than 2^30 primitives.
+pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], presplit: Presplit) -> Bvh {
+    build_with(tri_verts, spheres, quads, presplit, false)
 }
 
 /// [`build`] collapsed to the 8-wide compressed layout ([`crate::accel::wide_bvh::widen`]). Where the wide tree of
 /// the PLOC build would be too deep for the traversal stack, the median split's tree (depth ≤ 31 for any input
 /// size the references allow) is widened instead.
-pub fn build_wide(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad]) -> Bvh {
-    crate::accel::wide_bvh::widen(&build(tri_verts, spheres, quads)).unwrap_or_else(|| {
-        crate::accel::wide_bvh::widen(&build_with(tri_verts, spheres, quads, true))
+pub fn build_wide(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], presplit: Presplit) -> Bvh {
+    crate::accel::wide_bvh::widen(&build(tri_verts, spheres, quads, presplit)).unwrap_or_else(|| {
+        crate::accel::wide_bvh::widen(&build_with(tri_verts, spheres, quads, presplit, true))
             .expect("a median-split tree is shallow enough to widen")
     })
 }
 
-fn build_with(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], median: bool) -> Bvh {
+fn build_with(
+    tri_verts: &[[Vec3; 3]],
+    spheres: &[GpuSphere],
+    quads: &[GpuQuad],
+    presplit: Presplit,
+    median: bool,
+) -> Bvh {
     let start = Instant::now();
     for n in [tri_verts.len(), spheres.len(), quads.len()] {
         assert!(n as u64 <= PRIM_INDEX_MASK as u64 + 1, "a BVH holds at most 2^30 primitives of each kind");
@@ -282,10 +303,28 @@ fn build_with(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad],
         }
     };
     tri_verts.iter().enumerate().for_each(|(i, t)| add(PRIM_TRIANGLE, i, triangle_aabb(t)));
+    if let (Presplit::Large { keep_whole }, true) = (presplit, presplit_enabled()) {
+        // Pieces of large triangles: more references to the same triangles, each with a smaller box.
+        let (whole, kept): (Vec<Piece>, Vec<Piece>) = refs
+            .iter()
+            .zip(&boxes)
+            .map(|(&r, &bx)| Piece { tri: r & PRIM_INDEX_MASK, bx })
+            .partition(|p| !keep_whole.get(p.tri as usize).is_some_and(|&k| k));
+        let budget = (presplit::BUDGET * refs.len() as f64) as usize;
+        let pieces = presplit::split(&whole, tri_verts, budget);
+        refs = kept.iter().chain(&pieces).map(|p| make_prim(PRIM_TRIANGLE, p.tri)).collect();
+        boxes = kept.iter().chain(&pieces).map(|p| p.bx).collect();
+    }
+    let mut add = |kind: u32, i: usize, b: Option<Aabb>| {
+        if let Some(b) = b {
+            refs.push(make_prim(kind, i as u32));
+            boxes.push(b);
+        }
+    };
     spheres.iter().enumerate().for_each(|(i, s)| add(PRIM_SPHERE, i, sphere_aabb(s)));
     quads.iter().enumerate().for_each(|(i, q)| add(PRIM_QUAD, i, quad_aabb(q)));
 
-    let (tmp, order) = if boxes.is_empty() {
+    let (mut tmp, order) = if boxes.is_empty() {
         (Vec::new(), Vec::new())
     } else {
         let (tmp, order) = if median { build_median(&boxes) } else { build_obvhs(&boxes) };
@@ -297,9 +336,32 @@ fn build_with(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad],
             build_median(&boxes)
         }
     };
+    let order = distinct_in_leaves(&mut tmp, order, &refs);
     let mut bvh = flatten(&tmp, &order, &refs, &boxes);
     bvh.build_seconds = start.elapsed().as_secs_f64();
     bvh
+}
+
+/// Whether large triangles are pre-split ([`crate::accel::presplit`]); `MISLAB_PRESPLIT=0` turns it off for A/B
+/// runs.
+pub fn presplit_enabled() -> bool {
+    std::env::var("MISLAB_PRESPLIT").map_or(true, |v| v != "0")
+}
+
+/// Removes the second and later pieces of one triangle from each leaf (two pieces of a triangle may land in the
+/// same leaf; one test finds it). Returns the new `order`; leaves' `first` and `count` are rewritten.
+fn distinct_in_leaves(tmp: &mut [TmpNode], order: Vec<u32>, refs: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(order.len());
+    for t in tmp.iter_mut().filter(|t| t.count > 0) {
+        let first = out.len();
+        for &p in &order[t.first as usize..(t.first + t.count) as usize] {
+            if !out[first..].iter().any(|&q: &u32| refs[q as usize] == refs[p as usize]) {
+                out.push(p);
+            }
+        }
+        (t.first, t.count) = (first as u32, (out.len() - first) as u32);
+    }
+    out
 }
 
 /// PLOC + reinsertion + SAH leaf collapse by obvhs, on boxes normalised to the scene's bounds (so that huge

@@ -4,5 +4,6 @@
 pub mod bvh;
 pub mod convex_solids;
 pub mod light_tree;
+pub mod presplit;
 pub mod quantise;
 pub mod wide_bvh;

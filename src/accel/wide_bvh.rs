@@ -162,6 +162,19 @@ impl<'a> Bvh2View<'a> {
     }
 }
 
+/// Keeps the first of equal references in `refs[..count]` (two pieces of a pre-split triangle, from BVH2 leaves
+/// merged into one, need one test); returns the new count.
+fn distinct(refs: &mut [u32], count: u32) -> u32 {
+    let mut n = 0;
+    for k in 0..count as usize {
+        if !refs[..n].contains(&refs[k]) {
+            refs[n] = refs[k];
+            n += 1;
+        }
+    }
+    n as u32
+}
+
 /// SAH cost of a node step (Ylitie et al. 2017, §4.1)...
 const C_NODE: f64 = 1.0;
 /// ... and of one primitive test: on lavapipe a node step (three 32-byte loads, eight box tests) costs about two
@@ -286,7 +299,8 @@ impl<'a> Collapse<'a> {
         match self.choice[i][j - 1] {
             ONE_CHILD if self.as_leaf[i] => {
                 let mut refs = [0; MAX_LEAF_PRIMS as usize];
-                let count = self.view.gather(n, &mut refs, 0);
+                let gathered = self.view.gather(n, &mut refs, 0);
+                let count = distinct(&mut refs, gathered);
                 out.push(Child::Leaf { refs, count, bx });
             }
             ONE_CHILD => out.push(Child::Interior { node: n, bx }),
@@ -493,7 +507,7 @@ mod tests {
     #[test]
     fn collapse_builds_the_tree_its_costs_describe() {
         let tris = scattered(600);
-        let b2 = bvh::build(&tris, &[], &[]);
+        let b2 = bvh::build(&tris, &[], &[], bvh::Presplit::Off);
         let view = Bvh2View::new(&b2);
         let c = Collapse::new(&view);
         for n in 0..b2.nodes.len() {
@@ -558,7 +572,7 @@ mod tests {
         }
         for (n, skip) in [(12, 0), (18, 3)] {
             let tris: Vec<_> = scattered(n + skip).into_iter().skip(skip).collect();
-            let b2 = bvh::build(&tris, &[], &[]);
+            let b2 = bvh::build(&tris, &[], &[], bvh::Presplit::Off);
             let view = Bvh2View::new(&b2);
             let c = Collapse::new(&view);
             let (dp, _) = c.spread(0, WIDTH);

@@ -43,7 +43,7 @@ pub fn memory_per_triangle(data: &SceneData) -> TriangleMemory {
         let table = bindings::SCENE.iter().zip(sizes);
         table.filter(|(b, _)| names.contains(&b.binding.name)).map(|(_, s)| s).sum::<u64>() as f64
     };
-    let tris = data.tri_shading.len().max(1) as f64;
+    let tris = data.triangles.max(1) as f64;
     TriangleMemory {
         bvh: size(&["bvh_nodes", "prim_refs", "wide_nodes"]) / tris,
         geometry: size(&["tri_verts", "tri_verts_hi", "tri_verts_hi2", "tri_verts_hi3"]) / tris,

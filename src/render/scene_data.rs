@@ -31,6 +31,9 @@ pub struct SceneData {
     /// further vertex binding, at most `bindings::VERTEX_BINDINGS` − 1, each a whole number of triangles; empty
     /// unless split.
     pub tri_verts_hi: Vec<Vec<[f32; 4]>>,
+    /// Triangles in the scene. The per-triangle arrays hold one copy per BVH reference (a pre-split triangle,
+    /// `crate::accel::presplit`, is in several leaves), so they can be longer.
+    pub triangles: usize,
     /// Per-triangle shading data: shading-vertex indices and light (src/render/shading_data.rs). The CPU's view:
     /// it is uploaded as the w of `tri_verts` and as `tri_lights`.
     pub tri_shading: Vec<GpuTriShading>,
@@ -193,12 +196,22 @@ impl SceneData {
             }
         }
         d.offset_scale = if extent.is_finite() && extent > 0.0 { extent.clamp(1e-30, 1.0) } else { 1.0 };
-        let mut bvh = if bvh_layout_wide() {
-            bvh::build_wide(&tris, &d.spheres, &d.quads)
+        // Large triangles in pieces, except in scenes small enough to render without a BVH (one copy of each
+        // triangle) and emitters (a shadow ray towards one skips it by its index).
+        let emits = |i: usize| d.materials[d.tri_material(i) as usize].emission.iter().any(|&c| c > 0.0);
+        let keep_whole: Vec<bool> = (0..tris.len()).map(emits).collect();
+        let presplit = if tris.len() + d.spheres.len() + d.quads.len() > crate::render::baked::FLAT_MAX_PRIMS {
+            bvh::Presplit::Large { keep_whole: &keep_whole }
         } else {
-            bvh::build(&tris, &d.spheres, &d.quads)
+            bvh::Presplit::Off
+        };
+        let mut bvh = if bvh_layout_wide() {
+            bvh::build_wide(&tris, &d.spheres, &d.quads, presplit)
+        } else {
+            bvh::build(&tris, &d.spheres, &d.quads, presplit)
         };
         // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs.
+        d.triangles = tris.len();
         let order = bvh::into_leaf_order(&mut bvh, tris.len());
         tris = order.iter().map(|&i| tris[i as usize]).collect();
         d.tri_verts = order.iter().flat_map(|&i| d.tri_verts[3 * i as usize..3 * i as usize + 3].to_vec()).collect();
@@ -210,7 +223,7 @@ impl SceneData {
         d.prim_refs = if identity && !bvh.prim_refs.is_empty() { IDENTITY_PRIM_REFS.to_vec() } else { bvh.prim_refs };
         d.wide_nodes = bvh.wide;
         build_textures(scene, &mut d);
-        build_lights(scene, &tris, &mut d);
+        build_lights(scene, &tris, &bvh::first_copies(&order), &mut d);
         d.pack_triangle_records();
         d
     }
@@ -452,7 +465,9 @@ fn scene_radius(d: &SceneData) -> f64 {
     (0.5 * (hi - lo).length() as f64).max(1e-3)
 }
 
-fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
+/// `first_copy[i]`: the index of the first copy of triangle `i` (a pre-split triangle is in the geometry once per
+/// BVH reference; it is one light, and every copy says so).
+fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], first_copy: &[u32], d: &mut SceneData) {
     let mut lights: Vec<GpuLight> = Vec::new();
     let mut power: Vec<f64> = Vec::new();
     let emits = |m: u32| {
@@ -463,6 +478,10 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     let two_sided =
         |m: u32| if scene.materials.get(m as usize).is_some_and(|m| m.emission_two_sided) { 2u32 } else { 1 };
     for (i, t) in tris.iter().enumerate() {
+        if first_copy[i] as usize != i {
+            d.tri_shading[i].light = d.tri_shading[first_copy[i] as usize].light;
+            continue;
+        }
         let m = d.tri_material(i);
         if !emits(m) {
             continue;
