@@ -292,11 +292,66 @@ fn gpu_reads_every_triangle_record_as_the_cpu_wrote_it() {
 #[test]
 fn bench_scenes_fit_in_64_bytes_per_triangle() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/bench-scenes");
-    for name in ["damagedhelmet_grey", "livingroom_grey", "staircase2_grey", "scaling_1k", "scaling_100k"] {
+    for name in
+        ["damagedhelmet_grey", "livingroom_grey", "diningroom_grey", "staircase2_grey", "scaling_1k", "scaling_100k"]
+    {
         let data = SceneData::build(&common::scene(&format!("{dir}/{name}/{name}.toml")));
         let m = mislab::render::gpu_scene::memory_per_triangle(&data);
         eprintln!("{name}: {m:?}, total {:.1} B", m.total());
         assert!(data.tri_shading.len() > 900, "{name}: {} triangles", data.tri_shading.len());
         assert!(m.total() <= 64.0, "{name}: {:.1} bytes per triangle ({m:?})", m.total());
     }
+}
+
+/// Pre-split triangles (src/accel/presplit.rs) are uploaded once per BVH reference: every copy carries its
+/// triangle's positions and shading records, emitters are never split (each stays one light), the memory per
+/// triangle counts the scene's triangles, and scenes small enough to render without a BVH keep one copy each.
+#[test]
+fn presplit_copies_share_their_triangle_and_emitters_stay_whole() {
+    use mislab::scene::{Material, Mesh, Scene};
+    let mesh = |name: &str, tris: &[[Vec3; 3]], material: u32| Mesh {
+        name: name.into(),
+        positions: tris.iter().flatten().copied().collect(),
+        normals: vec![],
+        uvs: vec![],
+        indices: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+        material,
+    };
+    // A floor of 800 small triangles, two long diagonal slivers (one grey, one emissive).
+    let mut floor = Vec::new();
+    for i in 0..20 {
+        for j in 0..20 {
+            let o = Vec3::new(i as f32, 0.0, j as f32) * 0.5;
+            floor.push([o, o + Vec3::new(0.0, 0.0, 0.5), o + Vec3::new(0.5, 0.0, 0.0)]);
+            floor.push([o + Vec3::new(0.5, 0.0, 0.0), o + Vec3::new(0.0, 0.0, 0.5), o + Vec3::new(0.5, 0.0, 0.5)]);
+        }
+    }
+    let sliver = |y: f32| [Vec3::new(0.0, y, 0.0), Vec3::new(10.0, y + 5.0, 10.0), Vec3::new(10.0, y + 5.2, 10.0)];
+    let light = Material { emission: Vec3::splat(5.0), ..Material::default() };
+    let scene = |floor: &[[Vec3; 3]]| Scene {
+        materials: vec![Material::default(), light.clone()],
+        meshes: vec![mesh("floor", floor, 0), mesh("sliver", &[sliver(1.0)], 0), mesh("lamp", &[sliver(2.0)], 1)],
+        ..Scene::default()
+    };
+    let big = scene(&floor);
+    let data = SceneData::build(&big);
+    assert_eq!(data.triangles, 802);
+    let originals = original_triangles(&big, &data);
+    let copies = |m: usize| originals.iter().filter(|o| o.0 == m).count();
+    assert!(copies(1) > 2, "the grey sliver is split: {} copies", copies(1));
+    assert_eq!(copies(2), 1, "the emissive sliver stays whole");
+    assert_eq!(copies(0), 800, "the floor's small triangles are not split");
+    assert_eq!(data.tri_shading.len(), 801 + copies(1));
+    let first = |m: usize| originals.iter().position(|o| o.0 == m).unwrap();
+    for (i, o) in originals.iter().enumerate().filter(|(_, o)| o.0 == 1) {
+        assert_eq!(data.tri_shading[i], data.tri_shading[first(o.0)], "copy {i} of the sliver");
+    }
+    let lights = data.tri_shading.iter().filter(|t| t.light != mislab::gpu::types::INVALID).count();
+    assert_eq!((lights, data.lights.len()), (1, 1), "one emissive triangle, one light");
+    let m = mislab::render::gpu_scene::memory_per_triangle(&data);
+    let vertex_bytes = 48.0 * data.tri_shading.len() as f64 / 802.0;
+    assert!((m.geometry - vertex_bytes).abs() < 1e-9, "{m:?}: per scene triangle, copies included");
+    // Below the flat limit: one copy per triangle, in any case.
+    let small = scene(&floor[..20]);
+    assert_eq!(SceneData::build(&small).tri_shading.len(), 22);
 }

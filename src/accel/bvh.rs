@@ -107,7 +107,7 @@ impl Bvh {
 /// Renumbers the triangles in the order the leaves reference them, one new triangle per reference: a pre-split
 /// triangle ([`crate::accel::presplit`]) referenced from several leaves becomes as many copies. Returns `order`
 /// with `order[new] = old`: every reference's triangle, then those the tree excludes (degenerate ones); each old
-/// triangle appears at least once, and its first copy comes first. The caller permutes every per-triangle array by
+/// triangle appears at least once. The caller permutes every per-triangle array by
 /// it. In a triangle-only scene `prim_refs[j] == j` afterwards, so traversal reads a leaf's triangles directly
 /// (`shaders/bvh.wgsl`: three vertex loads per test instead of four); in mixed scenes the triangle references are
 /// rewritten to the new indices.
@@ -124,12 +124,6 @@ pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
     }
     order.extend((0..tri_count as u32).filter(|&old| !referenced[old as usize]));
     order
-}
-
-/// For each triangle of `order` ([`into_leaf_order`]), the new index of its first copy.
-pub fn first_copies(order: &[u32]) -> Vec<u32> {
-    let mut first = std::collections::HashMap::with_capacity(order.len());
-    order.iter().enumerate().map(|(new, &old)| *first.entry(old).or_insert(new as u32)).collect()
 }
 
 /// An axis-aligned box (f32, as uploaded).

@@ -223,7 +223,7 @@ impl SceneData {
         d.prim_refs = if identity && !bvh.prim_refs.is_empty() { IDENTITY_PRIM_REFS.to_vec() } else { bvh.prim_refs };
         d.wide_nodes = bvh.wide;
         build_textures(scene, &mut d);
-        build_lights(scene, &tris, &bvh::first_copies(&order), &mut d);
+        build_lights(scene, &tris, &mut d);
         d.pack_triangle_records();
         d
     }
@@ -465,9 +465,8 @@ fn scene_radius(d: &SceneData) -> f64 {
     (0.5 * (hi - lo).length() as f64).max(1e-3)
 }
 
-/// `first_copy[i]`: the index of the first copy of triangle `i` (a pre-split triangle is in the geometry once per
-/// BVH reference; it is one light, and every copy says so).
-fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], first_copy: &[u32], d: &mut SceneData) {
+/// Emissive triangles are never pre-split (`keep_whole` above), so each is one light with one copy.
+fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     let mut lights: Vec<GpuLight> = Vec::new();
     let mut power: Vec<f64> = Vec::new();
     let emits = |m: u32| {
@@ -478,10 +477,6 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], first_copy: &[u32], d: &mut S
     let two_sided =
         |m: u32| if scene.materials.get(m as usize).is_some_and(|m| m.emission_two_sided) { 2u32 } else { 1 };
     for (i, t) in tris.iter().enumerate() {
-        if first_copy[i] as usize != i {
-            d.tri_shading[i].light = d.tri_shading[first_copy[i] as usize].light;
-            continue;
-        }
         let m = d.tri_material(i);
         if !emits(m) {
             continue;
