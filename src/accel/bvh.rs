@@ -218,8 +218,8 @@ pub fn quad_aabb(q: &GpuQuad) -> Option<Aabb> {
     (finite3(b.min) && finite3(b.max)).then_some(b)
 }
 
-/// obvhs build settings: its "slow" preset's PLOC search (24 neighbours), without spatial pre-splits (they
-/// duplicate references and need triangles), with leaves of at most 4 primitives collapsed by the SAH with
+/// obvhs build settings: its "slow" preset's PLOC search (24 neighbours), without obvhs's own pre-splits (mislab
+/// splits before, with conservative boxes: [`crate::accel::presplit`]), with leaves of at most 4 primitives collapsed by the SAH with
 /// traversal cost 1 (our node tests two boxes per fetch; an intersection costs about as much). Reinsertion
 /// (moving subtrees to where they lower the SAH) starts from every node, before and after the leaf collapse, not
 /// the preset's 20 %: the build takes 2.5–3× as long (1M triangles: 2.3 → 6.9 s) and the trees render 0.86–1.0× the
