@@ -107,10 +107,9 @@ impl Bvh {
 /// Renumbers the triangles in the order the leaves reference them, one new triangle per reference: a pre-split
 /// triangle ([`crate::accel::presplit`]) referenced from several leaves becomes as many copies. Returns `order`
 /// with `order[new] = old`: every reference's triangle, then those the tree excludes (degenerate ones); each old
-/// triangle appears at least once. The caller permutes every per-triangle array by
-/// it. In a triangle-only scene `prim_refs[j] == j` afterwards, so traversal reads a leaf's triangles directly
-/// (`shaders/bvh.wgsl`: three vertex loads per test instead of four); in mixed scenes the triangle references are
-/// rewritten to the new indices.
+/// triangle appears at least once. The caller permutes every per-triangle array by it. In a triangle-only scene
+/// `prim_refs[j] == j` afterwards, so traversal reads a leaf's triangles directly (`shaders/bvh.wgsl`: three vertex
+/// loads per test instead of four); in mixed scenes the triangle references are rewritten to the new indices.
 pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
     let mut referenced = vec![false; tri_count];
     let mut order = Vec::with_capacity(tri_count);
@@ -219,11 +218,11 @@ pub fn quad_aabb(q: &GpuQuad) -> Option<Aabb> {
 }
 
 /// obvhs build settings: its "slow" preset's PLOC search (24 neighbours), without obvhs's own pre-splits (mislab
-/// splits before, with conservative boxes: [`crate::accel::presplit`]), with leaves of at most 4 primitives collapsed by the SAH with
-/// traversal cost 1 (our node tests two boxes per fetch; an intersection costs about as much). Reinsertion
-/// (moving subtrees to where they lower the SAH) starts from every node, before and after the leaf collapse, not
-/// the preset's 20 %: the build takes 2.5–3× as long (1M triangles: 2.3 → 6.9 s) and the trees render 0.86–1.0× the
-/// time (docs/profile-bvh.md, "BVH quality").
+/// splits before, with conservative boxes: [`crate::accel::presplit`]), with leaves of at most 4 primitives
+/// collapsed by the SAH with traversal cost 1 (our node tests two boxes per fetch; an intersection costs about as
+/// much). Reinsertion (moving subtrees to where they lower the SAH) starts from every node, before and after the
+/// leaf collapse, not the preset's 20 %: the build takes 2.5–3× as long (1M triangles: 2.3 → 6.9 s) and the trees
+/// render 0.86–1.0× the time (docs/profile-bvh.md, "BVH quality").
 fn build_params() -> obvhs::BvhBuildParams {
     obvhs::BvhBuildParams {
         pre_split: false,
@@ -287,28 +286,20 @@ fn build_with(
     for n in [tri_verts.len(), spheres.len(), quads.len()] {
         assert!(n as u64 <= PRIM_INDEX_MASK as u64 + 1, "a BVH holds at most 2^30 primitives of each kind");
     }
-    // Included primitives: their references and boxes.
-    let mut refs = Vec::with_capacity(tri_verts.len() + spheres.len() + quads.len());
-    let mut boxes = Vec::with_capacity(refs.capacity());
-    let mut add = |kind: u32, i: usize, b: Option<Aabb>| {
-        if let Some(b) = b {
-            refs.push(make_prim(kind, i as u32));
-            boxes.push(b);
-        }
-    };
-    tri_verts.iter().enumerate().for_each(|(i, t)| add(PRIM_TRIANGLE, i, triangle_aabb(t)));
+    // Included triangles, large ones in pieces (more references to the same triangle, each with a smaller box).
+    let mut tris: Vec<Piece> = (0..tri_verts.len())
+        .filter_map(|i| triangle_aabb(&tri_verts[i]).map(|bx| Piece { tri: i as u32, bx }))
+        .collect();
     if let (Presplit::Large { keep_whole }, true) = (presplit, presplit_enabled()) {
-        // Pieces of large triangles: more references to the same triangles, each with a smaller box.
-        let (whole, kept): (Vec<Piece>, Vec<Piece>) = refs
-            .iter()
-            .zip(&boxes)
-            .map(|(&r, &bx)| Piece { tri: r & PRIM_INDEX_MASK, bx })
-            .partition(|p| !keep_whole.get(p.tri as usize).is_some_and(|&k| k));
-        let budget = (presplit::BUDGET * refs.len() as f64) as usize;
-        let pieces = presplit::split(&whole, tri_verts, budget);
-        refs = kept.iter().chain(&pieces).map(|p| make_prim(PRIM_TRIANGLE, p.tri)).collect();
-        boxes = kept.iter().chain(&pieces).map(|p| p.bx).collect();
+        let budget = (presplit::BUDGET * tris.len() as f64) as usize;
+        let (split, mut kept): (Vec<Piece>, Vec<Piece>) =
+            tris.into_iter().partition(|p| !keep_whole.get(p.tri as usize).is_some_and(|&k| k));
+        kept.extend(presplit::split(&split, tri_verts, budget));
+        tris = kept;
     }
+    // Included primitives: their references and boxes.
+    let mut refs: Vec<u32> = tris.iter().map(|p| make_prim(PRIM_TRIANGLE, p.tri)).collect();
+    let mut boxes: Vec<Aabb> = tris.iter().map(|p| p.bx).collect();
     let mut add = |kind: u32, i: usize, b: Option<Aabb>| {
         if let Some(b) = b {
             refs.push(make_prim(kind, i as u32));
