@@ -158,7 +158,7 @@ fn finite3(v: Vec3) -> bool {
 }
 
 /// The next f32 towards +inf / -inf (for rounding sphere and quad boxes outwards).
-fn next_up(x: f32) -> f32 {
+pub(crate) fn next_up(x: f32) -> f32 {
     if x.is_nan() || x == f32::INFINITY {
         return x;
     }
@@ -169,7 +169,7 @@ fn next_up(x: f32) -> f32 {
     f32::from_bits(if x > 0.0 { b + 1 } else { b - 1 })
 }
 
-fn next_down(x: f32) -> f32 {
+pub(crate) fn next_down(x: f32) -> f32 {
     -next_up(-x)
 }
 
