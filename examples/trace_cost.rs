@@ -174,14 +174,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 
     impl DriverRays {
-        /// None where the first adapter offers no ray queries.
-        pub fn new(tris: &[[Vec3; 3]]) -> Option<DriverRays> {
+        /// On the adapter named `adapter` (the one the rest of the example traces on); None where it offers no
+        /// ray queries.
+        pub fn new(tris: &[[Vec3; 3]], adapter: &str) -> Option<DriverRays> {
             let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
             desc.backends = wgpu::Backends::VULKAN;
             let instance = wgpu::Instance::new(desc);
             let adapter = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN))
                 .into_iter()
-                .find(|a| a.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY))?;
+                .find(|a| a.get_info().name == adapter)
+                .filter(|a| a.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY))?;
             let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("ray queries"),
                 required_features: wgpu::Features::EXPERIMENTAL_RAY_QUERY,
@@ -356,7 +358,7 @@ fn main() {
         ("bounce rays, random order", bounce_rays(&tris, n, false)),
         ("bounce rays, sorted by origin cell + octant", bounce_rays(&tris, n, true)),
     ];
-    let driver = driver_rays::DriverRays::new(&tris);
+    let driver = driver_rays::DriverRays::new(&tris, &ctx.info.name);
     for (name, rays) in &sets {
         for function in ["probe_closest", "probe_any"] {
             let mut best = f64::MAX;
