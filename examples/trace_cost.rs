@@ -129,14 +129,14 @@ fn seconds(probe: &Probe, source: &str, function: &str, rays: &[ProbeRay], geo: 
 mod driver_rays {
     use super::ProbeRay;
     use glam::Vec3;
+    use mislab::testkit::probe::PROBE_RAY_WGSL;
     use std::time::Instant;
     use wgpu::util::DeviceExt;
 
     // The ray query is declared outside the loop: declared inside it, the first dispatch lost the device on
     // lavapipe 25.0.7 (wgpu 30.0.1) without any error reported.
+    // After `enable wgpu_ray_query;` and the probe's ray struct (mislab::testkit::probe::PROBE_RAY_WGSL).
     const KERNEL: &str = "
-enable wgpu_ray_query;
-struct ProbeRay { o: vec3<f32>, t_max: f32, d: vec3<f32>, _pad: f32 }
 @group(0) @binding(0) var<storage, read> rays: array<ProbeRay>;
 @group(0) @binding(1) var<storage, read_write> out: array<u32>;
 @group(0) @binding(2) var scene: acceleration_structure;
@@ -265,7 +265,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             });
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("ray query probe"),
-                source: wgpu::ShaderSource::Wgsl(KERNEL.into()),
+                source: wgpu::ShaderSource::Wgsl(format!("enable wgpu_ray_query;\n{PROBE_RAY_WGSL}{KERNEL}").into()),
             });
             Some(DriverRays { device, queue, tlas, _blas: blas, layout, pipeline_layout, module })
         }
