@@ -165,7 +165,7 @@ struct Light {
     pmf_uniform: f32,
     tree_trail: u32,       // the light's root-to-leaf path in light_tree (bit k: second child at depth k)
     two_sided: u32,        // 1: an area light emitting from both faces (triangles, quads)
-    _pad1: u32,
+    shadow_box: u32,       // 1: a triangle of an isolated emitter; position/direction hold its stop box (lo/hi)
     _pad2: u32,
 }
 

@@ -99,6 +99,37 @@ fn spawn_origin(x: Surface, w: vec3<f32>) -> vec3<f32> {
     return offset_ray_origin_scaled(x.p, select(-x.ng, x.ng, dot(w, x.ng) > 0.0), params.offset_scale);
 }
 
+/// Where a shadow ray from o along d enters the stop box of the isolated emitter that light primitive `prim` belongs
+/// to (src/accel/isolated_emitters.rs: nothing else is in that box, and no part of the emitter can hide a point of
+/// it that a light sample aims at), or F32_MAX: no such box, or o inside it. Rounding may only move the stop later
+/// (further into the box, which is empty but for the emitter), never earlier.
+fn stop_box_entry(prim: u32, o: vec3<f32>, d: vec3<f32>) -> f32 {
+    if !HAS_TRIANGLE_LIGHTS || prim_kind(prim) != PRIM_TRIANGLE {
+        return F32_MAX;
+    }
+    let li = scene_tri_light(prim & PRIM_INDEX_MASK);
+    if li == INVALID || lights[li].shadow_box == 0u {
+        return F32_MAX;
+    }
+    let lo = lights[li].position;
+    let hi = lights[li].direction;
+    // A direction component near 0 takes a tiny stand-in of its sign: that slab's planes then lie at ±huge t,
+    // as they should (never NaN from 0 · ∞).
+    let sgn = select(vec3<f32>(1.0), vec3<f32>(-1.0), d < vec3<f32>(0.0));
+    let inv = 1.0 / select(d, sgn * 1e-30, abs(d) < vec3<f32>(1e-30));
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
+    let near = min(t0, t1);
+    let entry = max(max(near.x, near.y), near.z);
+    if !(entry > 0.0) {
+        return F32_MAX;
+    }
+    // Each plane's t is rounded twice (the difference, the product): 2⁻²² of |t| and of o's own magnitude along
+    // the ray bound that; 1e-5 of both is far beyond it.
+    let o_scale = max(max(abs(o.x), abs(o.y)), abs(o.z));
+    return entry + 1e-5 * (entry + o_scale);
+}
+
 /// Whether nothing blocks the segment from x to the light sample's point (or direction, for distant lights).
 fn unoccluded(x: Surface, ls: LightSample) -> bool {
     let o = spawn_origin(x, ls.wi);
@@ -116,6 +147,7 @@ fn unoccluded(x: Surface, ls: LightSample) -> bool {
         let y_err = 64.0 * 1.2e-7 * (max(max(abs(x.p.x), abs(x.p.y)), abs(x.p.z)) + len);
         t_max = len - max(len * 1e-5, y_err);
         if (t_max <= 0.0) { return false; }
+        t_max = min(t_max, stop_box_entry(ls.prim, o, shadow_dir));
     }
     rays_traced += 1u;
     return !trace_any_except(o, shadow_dir, t_max, ls.prim);

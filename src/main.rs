@@ -377,6 +377,24 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
                 Environment::Map { map, .. } => format!("map {} ({}x{})", map.path.display(), map.width, map.height),
             }
         );
+        let boxed: Vec<_> = data.lights.iter().filter(|l| l.shadow_box == 1).collect();
+        if !boxed.is_empty() {
+            let mut meshes: Vec<[u32; 6]> = boxed
+                .iter()
+                .map(|l| {
+                    let [a, b, c] = l.position.map(f32::to_bits);
+                    let [d, e, f] = l.direction.map(f32::to_bits);
+                    [a, b, c, d, e, f]
+                })
+                .collect();
+            meshes.sort_unstable();
+            meshes.dedup();
+            println!(
+                "isolated emitters: {} triangle lights in {} meshes; shadow rays towards them stop at the mesh's box",
+                boxed.len(),
+                meshes.len()
+            );
+        }
         println!(
             "BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes",
             data.bvh_node_count(),

@@ -86,7 +86,7 @@ fn shared_structs_match() {
             pmf_uniform,
             tree_trail,
             two_sided,
-            _pad1,
+            shadow_box,
             _pad2
         ]
     );

@@ -3,6 +3,7 @@
 
 pub mod bvh;
 pub mod convex_solids;
+pub mod isolated_emitters;
 pub mod light_tree;
 pub mod presplit;
 pub mod quantise;

@@ -142,7 +142,9 @@ pub struct GpuLight {
     pub tree_trail: u32,
     /// 1: an area light emitting from both faces (triangles and quads).
     pub two_sided: u32,
-    pub _pad1: u32,
+    /// 1: a triangle of an isolated emitter mesh (`accel::isolated_emitters`), whose stop box `position`
+    /// (lower corner) and `direction` (upper corner) hold: a shadow ray towards it may end where it enters that box.
+    pub shadow_box: u32,
     pub _pad2: u32,
 }
 

@@ -2,6 +2,7 @@
 //! data, light table, textures, environment distribution); `gpu_scene` uploads them.
 
 use crate::accel::bvh;
+use crate::accel::isolated_emitters::isolated_emitters;
 use crate::accel::light_tree::{GpuLightNode, LightBounds, LightTree};
 use crate::gpu::types::*;
 use crate::render::lights::{self, luminance};
@@ -465,6 +466,36 @@ fn scene_radius(d: &SceneData) -> f64 {
     (0.5 * (hi - lo).length() as f64).max(1e-3)
 }
 
+/// Gives the triangle lights of isolated emitter meshes their stop box (`accel::isolated_emitters`): a shadow ray
+/// towards one may end where it enters that box. `MISLAB_SHADOW_BOX=0` turns it off (for A/B runs).
+fn mark_isolated_emitters(tris: &[[Vec3; 3]], d: &SceneData, lights: &mut [GpuLight]) {
+    if std::env::var("MISLAB_SHADOW_BOX").is_ok_and(|v| v == "0") {
+        return;
+    }
+    let light_of = |i: usize| d.tri_shading.get(i).map_or(INVALID, |s| s.light);
+    let emitter = |i: usize| {
+        let l = light_of(i);
+        (l != INVALID).then(|| lights[l as usize].two_sided == 1)
+    };
+    let spheres = d.spheres.iter().map(|s| {
+        let (c, r) = (Vec3::from(s.center), Vec3::splat(s.radius));
+        (c - r, c + r)
+    });
+    let quads = d.quads.iter().map(|q| {
+        let c = Vec3::from(q.corner);
+        let (u, v) = (Vec3::from(q.edge_u), Vec3::from(q.edge_v));
+        let ps = [c, c + u, c + v, c + u + v];
+        (ps.iter().fold(Vec3::INFINITY, |a, &p| a.min(p)), ps.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p)))
+    });
+    let others: Vec<(Vec3, Vec3)> = spheres.chain(quads).collect();
+    for mesh in isolated_emitters(tris, emitter, &others) {
+        for t in mesh.triangles {
+            let l = &mut lights[light_of(t) as usize];
+            (l.position, l.direction, l.shadow_box) = (mesh.lo.into(), mesh.hi.into(), 1);
+        }
+    }
+}
+
 /// Emissive triangles are never pre-split (`keep_whole` above), so each is one light with one copy.
 fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
     let mut lights: Vec<GpuLight> = Vec::new();
@@ -514,6 +545,7 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
         let two_sided = (sides == 2) as u32;
         lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, two_sided, ..Default::default() });
     }
+    mark_isolated_emitters(tris, d, &mut lights);
     let r = scene_radius(d);
     // Lights with a position first, then the infinite ones (directional, environment): the light tree covers
     // the first `bounded` entries and the shader finds the infinite ones after them.
