@@ -7,14 +7,15 @@
 //! the two are checked to find the same closest primitives.
 //! `cargo run --release --example trace_cost [RAYS]`
 
-use glam::{Vec3, Vec3Swizzles};
+use glam::Vec3;
 use mislab::accel::bvh;
 use mislab::gpu::GpuContext;
 use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay};
 use std::time::Instant;
 
-const HELMET: &str =
-    concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
+#[path = "common/rays.rs"]
+mod rays;
+use rays::{bounce_rays, bounds};
 
 const KERNEL: &str = "
 override REPEAT: u32 = 1u;
@@ -41,21 +42,6 @@ fn probe_any(r: ProbeRay) -> u32 {
 }
 ";
 
-/// DamagedHelmet's triangles as mislab loads them (the product's glTF import and scene flattening).
-fn helmet() -> Vec<[Vec3; 3]> {
-    let scene = mislab::scene::load(HELMET, &mislab::scene::LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    let data = mislab::render::scene_data::SceneData::build(&scene);
-    data.tri_verts.chunks_exact(3).map(|t| [0, 1, 2].map(|k| Vec3::from_slice(&t[k][..3]))).collect()
-}
-
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
 /// Camera rays of a `side`² image in 8×8 tiles (a workgroup's lanes), looking at the model from +z.
 fn camera_rays(tris: &[[Vec3; 3]], side: u32) -> Vec<ProbeRay> {
     let (lo, hi) = bounds(tris);
@@ -75,45 +61,6 @@ fn camera_rays(tris: &[[Vec3; 3]], side: u32) -> Vec<ProbeRay> {
         }
     }
     rays
-}
-
-fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
-    tris.iter().flatten().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)))
-}
-
-/// Bounce-like rays: from a random point of a random triangle, cosine-distributed about its normal, in random
-/// order (`sorted`: ordered by the origin's cell on a 64³ grid and the direction's octant, a crude ray sort).
-fn bounce_rays(tris: &[[Vec3; 3]], n: usize, sorted: bool) -> Vec<ProbeRay> {
-    let mut rng = Lcg(7);
-    let (lo, hi) = bounds(tris);
-    let mut rays: Vec<(u64, ProbeRay)> = (0..n)
-        .filter_map(|_| {
-            let t = tris[(rng.next() * tris.len() as f32) as usize % tris.len()];
-            let ng = (t[1] - t[0]).cross(t[2] - t[0]);
-            if ng.length_squared() == 0.0 {
-                return None;
-            }
-            let ng = ng.normalize();
-            let (mut a, mut b) = (rng.next(), rng.next());
-            if a + b > 1.0 {
-                (a, b) = (1.0 - a, 1.0 - b);
-            }
-            let p = t[0] + a * (t[1] - t[0]) + b * (t[2] - t[0]);
-            let (u1, u2) = (rng.next(), rng.next());
-            let (s, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-            let (tx, ty) = ng.any_orthonormal_pair();
-            let d = (tx * s * phi.cos() + ty * s * phi.sin() + ng * (1.0 - u1).max(0.0).sqrt()).normalize();
-            let o = p + ng * 1e-4 * (hi - lo).length();
-            let cell = ((o - lo) / (hi - lo) * 63.99).as_uvec3();
-            let oct = (d.x > 0.0) as u64 | ((d.y > 0.0) as u64) << 1 | ((d.z > 0.0) as u64) << 2;
-            let key = oct << 40 | (cell.xzy().x as u64) << 12 | (cell.y as u64) << 6 | cell.z as u64;
-            Some((key, ProbeRay { o: o.into(), t_max: f32::MAX, d: d.into(), _pad: 0.0 }))
-        })
-        .collect();
-    if sorted {
-        rays.sort_by_key(|r| r.0);
-    }
-    rays.into_iter().map(|r| r.1).collect()
 }
 
 fn seconds(probe: &Probe, source: &str, function: &str, rays: &[ProbeRay], geo: &GeometryBuffers) -> f64 {
@@ -346,7 +293,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn main() {
     let n: usize = std::env::args().nth(1).map(|s| s.parse().expect("RAYS")).unwrap_or(1 << 19);
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
-    let tris = helmet();
+    let tris = rays::triangles(rays::HELMET);
     let wide = bvh::build_wide(&tris, &[], &[], bvh::Presplit::Large { keep_whole: &[] });
     let geo = GeometryBuffers::new(&ctx, &wide, &tris, &[], &[]);
     let library = mislab::testkit::probe::trace_module(KERNEL)
