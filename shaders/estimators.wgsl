@@ -124,10 +124,9 @@ fn stop_box_entry(prim: u32, o: vec3<f32>, d: vec3<f32>) -> f32 {
     if !(entry > 0.0) {
         return F32_MAX;
     }
-    // Each plane's t is rounded twice (the difference, the product): 2⁻²² of |t| and of o's own magnitude along
-    // the ray bound that; 1e-5 of both is far beyond it.
-    let o_scale = max(max(abs(o.x), abs(o.y)), abs(o.z));
-    return entry + 1e-5 * (entry + o_scale);
+    // Each plane's t is (lo − o) · (1/d) with three roundings, each relative to its own result (a float
+    // subtraction is exact but for the rounding of the difference), so within 3 · 2⁻²⁴ of t: 1e-5 of t is far beyond.
+    return entry * (1.0 + 1e-5);
 }
 
 /// Whether nothing blocks the segment from x to the light sample's point (or direction, for distant lights).
