@@ -324,10 +324,27 @@ struct Plan {
     dir_scale: f32,
 }
 
+/// Whether the environment guide draws the sky samples at c (a constant sky, guided, and c's slot learned).
+fn first_hit_guided(c: ShadingCtx) -> bool {
+    if (ENV_KIND == 0u) { return false; }
+    return env_guided_slot(c.x.p, env_receiver(c.x.ns, bsdf_transmits(c.brdf))) != INVALID;
+}
+
 fn strategy_plan(c: ShadingCtx) -> Plan {
     let s = cfg_strategy();
     var p = Plan(0u, 1.0, 0u, 1.0);
-    if (s == STRATEGY_LIGHT || s == STRATEGY_MIS) { p.light_runs = params.light_samples; }
+    if (s == STRATEGY_LIGHT || s == STRATEGY_MIS) {
+        p.light_runs = params.light_samples;
+        // Splitting at a path's first vertex where the environment guide applies (the sky seldom seen from there:
+        // a light sample is a rare success, and a blocked shadow ray ends early): the light technique's estimate
+        // is the mean of more samples, each with the MIS weight of --light-samples (any weights that sum to one
+        // with the direction technique's keep the sum unbiased). Counting them in the weights (n_l · p_l) would
+        // shift weight off the path's continuation, whose light and the indirect light behind it vary together;
+        // that raised the helmet's error (docs/estimators.md, "Light samples split at the first vertex").
+        if (c.bounce == 0u && cfg_mode() == MODE_PATH && first_hit_guided(c)) {
+            p.light_runs = min(p.light_runs * params.first_hit_light_split, 64u);
+        }
+    }
     if (s != STRATEGY_LIGHT) { p.dir_runs = params.bsdf_samples; }
     p.light_div = f32(p.light_runs);
     p.dir_scale = 1.0 / f32(max(p.dir_runs, 1u));

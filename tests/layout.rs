@@ -136,7 +136,7 @@ fn shared_structs_match() {
             offset_scale,
             ris_candidates,
             tile_row_stride,
-            _pad2,
+            first_hit_light_split,
             guide_min,
             guide_train,
             guide_inv_cell,

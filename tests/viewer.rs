@@ -33,6 +33,7 @@ const SETTING_NAMES: &[&str] = &[
     "mis",
     "light-samples",
     "bsdf-samples",
+    "first-hit-light-split",
     "sampler",
     "max-depth",
     "seed",

@@ -503,7 +503,7 @@ impl Renderer {
             offset_scale: self.offset_scale,
             ris_candidates: s.ris_candidates,
             tile_row_stride: tile_row_stride(s.height.div_ceil(8)),
-            _pad2: 0,
+            first_hit_light_split: s.first_hit_light_split,
             guide_min: self.guide_grid.min.into(),
             guide_train: self.guide_train,
             guide_inv_cell: self.guide_grid.inv_cell.into(),

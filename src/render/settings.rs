@@ -6,6 +6,11 @@ use serde::{Deserialize, Serialize};
 /// Default bounce count from which Russian roulette decides whether a path continues (issue 3: "after depth 3").
 pub const RR_DEPTH: u32 = 3;
 
+/// Default light-technique splitting at a path's first vertex where the environment guide applies: three times
+/// the light samples there, at unchanged MIS weights (docs/estimators.md, "Light samples split at the first
+/// vertex").
+pub const FIRST_HIT_LIGHT_SPLIT: u32 = 3;
+
 /// Declares a settings enum whose discriminants are the WGSL tag constants, with kebab-case names
 /// (the CLI / viewer / bench spelling) and an `ALL` list that tests and the viewer iterate over.
 macro_rules! settings_enum {
@@ -193,6 +198,11 @@ pub struct Settings {
     /// BSDF samples per shading point (MIS multi, BSDF strategies).
     #[arg(long, default_value_t = Settings::default().bsdf_samples)]
     pub bsdf_samples: u32,
+    /// Path mode: at a path's first vertex, where the environment guide applies (the sky seldom seen from there),
+    /// the light technique takes this many times --light-samples samples and averages them (splitting), with the
+    /// MIS weights of --light-samples; 1 = no splitting.
+    #[arg(long, default_value_t = Settings::default().first_hit_light_split)]
+    pub first_hit_light_split: u32,
     /// Sample sequence.
     #[arg(long, value_enum, default_value_t = Settings::default().sampler)]
     pub sampler: SamplerKind,
@@ -227,6 +237,7 @@ impl Default for Settings {
             ris_candidates: 8,
             light_samples: 1,
             bsdf_samples: 1,
+            first_hit_light_split: FIRST_HIT_LIGHT_SPLIT,
             sampler: SamplerKind::Independent,
             max_depth: 8,
             rr_depth: RR_DEPTH,
@@ -247,6 +258,12 @@ impl Settings {
         }
         if self.light_samples > 64 || self.bsdf_samples > 64 || self.light_samples + self.bsdf_samples == 0 {
             return Err("--light-samples and --bsdf-samples must be in 0..=64 and not both 0".into());
+        }
+        if self.first_hit_light_split == 0 || self.light_samples * self.first_hit_light_split > 64 {
+            return Err(format!(
+                "--first-hit-light-split {} is out of range (1 to 64 / --light-samples)",
+                self.first_hit_light_split
+            ));
         }
         if self.ris_candidates == 0 || self.ris_candidates > 64 {
             return Err(format!("--ris-candidates {} is out of range (1..=64)", self.ris_candidates));

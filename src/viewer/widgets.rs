@@ -123,6 +123,7 @@ pub fn settings_grid(ui: &mut egui::Ui, settings: &mut [Settings; 2], sides: usi
         drag_row!("light-samples", light_samples, |v| egui::DragValue::new(v).range(0..=64));
         drag_row!("ris-candidates", ris_candidates, |v| egui::DragValue::new(v).range(1..=64));
         drag_row!("bsdf-samples", bsdf_samples, |v| egui::DragValue::new(v).range(0..=64));
+        drag_row!("first-hit-light-split", first_hit_light_split, |v| egui::DragValue::new(v).range(1..=64));
         combo_row!("sampler", sampler, SamplerKind);
         drag_row!("max-depth", max_depth, |v| egui::DragValue::new(v).range(1..=256));
         drag_row!("seed", seed, |v| egui::DragValue::new(v));
