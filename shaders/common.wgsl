@@ -263,8 +263,8 @@ struct FrameParams {
     ris_candidates: u32,
     /// Workgroup row j of the dispatch renders tile row (j · stride) mod rows (src/render/tile_order.rs).
     tile_row_stride: u32,
-    /// Path mode: the light technique's samples at the first vertex are light_samples × this (estimators.wgsl
-    /// strategy_plan).
+    /// Path mode: the light technique's samples at a first vertex where the environment guide applies are
+    /// light_samples × this (estimators.wgsl strategy_plan).
     first_hit_light_split: u32,
     /// The environment guide's grid (src/render/env_guide.rs): its lower corner, 1 / cell size, cells per axis.
     guide_min: vec3<f32>,

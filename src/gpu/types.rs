@@ -227,7 +227,8 @@ pub struct GpuFrameParams {
     pub ris_candidates: u32,
     /// Workgroup row j of the dispatch renders tile row (j · stride) mod rows (`render::tile_order`).
     pub tile_row_stride: u32,
-    /// Path mode: the light technique's samples at the first vertex are `light_samples` × this (`Settings`).
+    /// Path mode: the light technique's samples at a first vertex where the environment guide applies are
+    /// `light_samples` × this (`Settings::first_hit_light_split`).
     pub first_hit_light_split: u32,
     /// The environment guide's grid: lower corner (render-origin space), 1 / cell size, cells per axis
     /// (`render::env_guide`).
