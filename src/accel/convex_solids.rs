@@ -6,6 +6,7 @@
 //! (its origin being outside, as a shadow ray's offset origin is). A box then costs six plane clips instead of
 //! twelve watertight triangle tests, and the half-space test has no cracks to leak through either.
 
+use crate::accel::mesh_components::mesh_components;
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -39,27 +40,8 @@ pub fn convex_solids(tri_verts: &[[f32; 4]], n: usize, excluded: impl Fn(usize) 
             })
         })
         .collect();
-    // Connected components (triangles sharing a vertex), by union–find over vertices.
-    let mut parent: Vec<usize> = (0..points.len()).collect();
-    fn root(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    for c in &corners {
-        for k in 1..3 {
-            let (a, b) = (root(&mut parent, c[0]), root(&mut parent, c[k]));
-            parent[a] = b;
-        }
-    }
-    let mut components: HashMap<usize, Vec<usize>> = HashMap::new();
-    for (t, c) in corners.iter().enumerate() {
-        components.entry(root(&mut parent, c[0])).or_default().push(t);
-    }
-    let mut solids: Vec<ConvexSolid> = components
-        .into_values()
+    let mut solids: Vec<ConvexSolid> = mesh_components(&corners, points.len())
+        .into_iter()
         .filter(|tris| !tris.iter().any(|&t| excluded(t)))
         .filter_map(|tris| solid_of(&tris, &corners, &points))
         .collect();

@@ -12,6 +12,7 @@
 //! where most of a shadow ray's node and triangle tests were spent (docs/estimators.md, "Shadow rays that stop at
 //! an isolated emitter").
 
+use crate::accel::mesh_components::mesh_components;
 use glam::{DVec3, Vec3};
 use std::collections::{HashMap, HashSet};
 
@@ -28,8 +29,8 @@ pub struct IsolatedEmitter {
 /// Relative tolerance (of the mesh's size) for "on the plane" and "behind the plane": vertices given in f32.
 const PLANE_TOLERANCE: f64 = 1e-6;
 
-/// Margin (relative to the mesh's largest extent) that no other primitive's box may enter: the stop box is padded
-/// by half of it, so rounding in the shader's box entry (≈ 1e-7 relative) stays inside the empty margin.
+/// Margin (relative to the mesh's largest extent) that no other primitive's box may enter; the stop box is padded by
+/// half of it. Slack only: the shader already moves its stop past the box's entry by more than the entry's rounding.
 const MARGIN: f32 = 1e-3;
 
 /// The isolated emitter meshes among `tris`. `emitter(i)`: None if triangle i does not emit, else whether it emits
@@ -76,25 +77,11 @@ fn emitter_meshes(tris: &[[Vec3; 3]], emitter: &impl Fn(usize) -> Option<bool>) 
         });
         corners.push((i, c));
     }
-    let mut parent: Vec<usize> = (0..ids.len()).collect();
-    fn root(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    for (_, c) in &corners {
-        for k in 1..3 {
-            let (a, b) = (root(&mut parent, c[0]), root(&mut parent, c[k]));
-            parent[a] = b;
-        }
-    }
-    let mut meshes: HashMap<usize, Vec<usize>> = HashMap::new();
-    for (i, c) in &corners {
-        meshes.entry(root(&mut parent, c[0])).or_default().push(*i);
-    }
-    let mut meshes: Vec<Vec<usize>> = meshes.into_values().collect();
+    let ids_of: Vec<[usize; 3]> = corners.iter().map(|c| c.1).collect();
+    let mut meshes: Vec<Vec<usize>> = mesh_components(&ids_of, ids.len())
+        .into_iter()
+        .map(|m| m.into_iter().map(|k| corners[k].0).collect())
+        .collect();
     meshes.sort_by_key(|m| m[0]);
     meshes
 }
@@ -106,7 +93,6 @@ fn shadow_safe(
     emitter: &impl Fn(usize) -> Option<bool>,
     mesh: Vec<usize>,
 ) -> Option<IsolatedEmitter> {
-    let d = |p: Vec3| DVec3::new(p.x as f64, p.y as f64, p.z as f64);
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for &t in &mesh {
@@ -123,13 +109,13 @@ fn shadow_safe(
     // origin is convex only up to those).
     let size = (extent as f64) * 3f64.sqrt();
     let tol = PLANE_TOLERANCE * (size + lo.abs().max(hi.abs()).max_element() as f64);
-    let points: Vec<DVec3> = mesh.iter().flat_map(|&t| tris[t].map(d)).collect();
+    let points: Vec<DVec3> = mesh.iter().flat_map(|&t| tris[t].map(|p| p.as_dvec3())).collect();
     let planar = {
         // The plane of the largest triangle.
         let (a, n) = mesh
             .iter()
             .map(|&t| {
-                let [a, b, c] = tris[t].map(d);
+                let [a, b, c] = tris[t].map(|p| p.as_dvec3());
                 (a, (b - a).cross(c - a))
             })
             .max_by(|x, y| x.1.length_squared().total_cmp(&y.1.length_squared()))?;
@@ -151,8 +137,7 @@ fn convex_outward(tris: &[[Vec3; 3]], mesh: &[usize], tol: f64) -> bool {
         return false;
     }
     let mut weld = Weld::new(tol);
-    let corners: Vec<[usize; 3]> =
-        mesh.iter().map(|&t| tris[t].map(|p| weld.id(DVec3::new(p.x as f64, p.y as f64, p.z as f64)))).collect();
+    let corners: Vec<[usize; 3]> = mesh.iter().map(|&t| tris[t].map(|p| weld.id(p.as_dvec3()))).collect();
     let points = weld.points;
     let mut directed: HashSet<(usize, usize)> = HashSet::new();
     for c in &corners {

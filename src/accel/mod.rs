@@ -5,6 +5,7 @@ pub mod bvh;
 pub mod convex_solids;
 pub mod isolated_emitters;
 pub mod light_tree;
+pub mod mesh_components;
 pub mod presplit;
 pub mod quantise;
 pub mod wide_bvh;
