@@ -268,7 +268,8 @@ struct FrameParams {
     first_hit_light_split: u32,
     /// The environment guide's grid (src/render/env_guide.rs): its lower corner, 1 / cell size, cells per axis.
     guide_min: vec3<f32>,
-    /// > 0: the guide's learning pass (GUIDE_LEARN: also accumulated; GUIDE_LEARN_ONLY: counts only).
+    /// The guide's learning pass (GUIDE_LEARN: also accumulated; GUIDE_LEARN_ONLY: counts only), over the learner
+    /// tiles only, or the rest of sample 0 after it (GUIDE_COMPLETE); 0: neither.
     guide_train: u32,
     guide_inv_cell: vec3<f32>,
     /// The guide's slots (cells × 6 normal classes).
@@ -276,6 +277,11 @@ struct FrameParams {
     guide_dims: vec3<u32>,
     /// 1 once a guide has been learned (guide_cdf holds it).
     guide_on: u32,
+    /// One 8×8 tile in this many learns the guide (1, 2 or 4; env_guide_learner_tile).
+    guide_learner_period: u32,
+    _pad_guide0: u32,
+    _pad_guide1: u32,
+    _pad_guide2: u32,
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;

@@ -14,6 +14,23 @@
 const GUIDE_LEARN: u32 = 1u;
 /// guide_train: a learning pass that only counts (sample 0 again, for a render resumed past it).
 const GUIDE_LEARN_ONLY: u32 = 2u;
+/// guide_train: the rest of sample 0 after a learning pass (the pixels outside the learner tiles), guided.
+const GUIDE_COMPLETE: u32 = 3u;
+
+/// Whether the 8×8 tile (tx, ty) learns the guide: every guide_learner_period-th diagonal (src/render/env_guide.rs
+/// `learner_tile`, which tests/estimators.rs checks against this).
+fn env_guide_learner_tile(tx: u32, ty: u32) -> bool {
+    return (tx + ty) % max(params.guide_learner_period, 1u) == 0u;
+}
+
+/// Whether this dispatch leaves pixel px alone: a learning pass renders the learner tiles' pixels only, the
+/// pass completing sample 0 after it the others only.
+fn env_guide_skips(px: vec2<u32>) -> bool {
+    let t = params.guide_train;
+    if (t == 0u) { return false; }
+    let learner = env_guide_learner_tile(px.x / 8u, px.y / 8u);
+    return select(!learner, learner, t == GUIDE_COMPLETE);
+}
 
 const GUIDE_Z_BINS: u32 = 8u;
 const GUIDE_PHI_BINS: u32 = 16u;

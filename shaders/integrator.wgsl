@@ -128,7 +128,8 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
     // the image (src/render/tile_order.rs).
     let row = 8u * ((wg.y * max(params.tile_row_stride, 1u)) % groups.y) + lid3.y;
     let px = vec2<u32>(gid.x, row + params.row_offset);
-    if (px.x >= params.width || row >= params.row_count || px.y >= params.height) { return; }
+    // Sample 0 of a guided render comes in two passes: the guide's learners, then the rest (env_guide.wgsl).
+    if (px.x >= params.width || row >= params.row_count || px.y >= params.height || env_guide_skips(px)) { return; }
     let pixel = px.y * params.width + px.x;
     let n = min(params.samples_per_dispatch, 65536u);
     let depth = select(min(params.max_depth, MAX_PATH_VERTICES), 1u, cfg_mode() == MODE_DIRECT);

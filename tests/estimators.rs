@@ -1169,35 +1169,95 @@ fn light_samples_split_at_the_first_vertex_agree_at_lower_variance() {
 const SPLIT_VARIANCE_GAIN: f64 = 1.1;
 
 /// A guided render resumed past its first sample (whose learning pass taught the guide) relearns the same guide
-/// from sample 0 and continues bit for bit as if it had never stopped: state files and `--part` depend on it.
+/// from sample 0 and continues bit for bit as if it had never stopped: state files and `--part` depend on it. With
+/// every tile learning (a small film's choice) and with one tile in four (a large film's).
 #[test]
 fn a_guided_render_resumed_past_its_first_sample_continues_bit_for_bit() {
-    // 64² paths in the learning pass: enough for the window room's guide (at 24² no slot reached 8 counts).
-    let (w, h) = (64, 64);
+    // 64² paths in the learning pass: enough for the window room's guide (at 24² no slot reached 8 counts); with
+    // one learner tile in four, 96² (the room's window is then seen from 36 of the 144 tiles).
+    for (period, size) in [(1, 64), (4, 96)] {
+        let (w, h) = (size, size);
+        let scene = window_room();
+        let settings = Settings {
+            mode: Mode::Path,
+            max_depth: 3,
+            env_sampling: EnvSampling::Guided,
+            sampler: SamplerKind::Sobol,
+            ..cfg(Strategy::Mis).apply(&small(w, h))
+        };
+        let gs = GpuScene::upload(ctx(), SceneData::build(&scene)).expect("upload");
+        let accum = |r: &Renderer| -> Vec<mislab::gpu::types::GpuAccum> {
+            ctx().read_pod(r.accum_buffer(), (w * h) as usize).expect("readback")
+        };
+        let renderer = || {
+            let mut r = Renderer::new(ctx(), &gs, scene.camera.clone(), settings.clone()).expect("renderer");
+            r.set_guide_learner_period(Some(period));
+            r
+        };
+        let mut whole = renderer();
+        whole.render(ctx(), 6).expect("render");
+        let mut first = renderer();
+        first.render(ctx(), 2).expect("render");
+        let mut resumed = renderer();
+        resumed.restore(&accum(&first), 2, first.nonfinite_total(), first.rays_total()).expect("restore");
+        resumed.render(ctx(), 4).expect("render");
+        assert_eq!(resumed.samples(), 6);
+        assert!(whole.guide_coverage().is_some_and(|(g, _)| g > 0), "period {period}: the guide learned nothing");
+        assert_eq!(
+            whole.guide_coverage(),
+            resumed.guide_coverage(),
+            "period {period}: the resumed render learned another guide"
+        );
+        let whole_accum = accum(&whole);
+        assert!(whole_accum.iter().all(|a| a.count + a.nonfinite == 6), "period {period}: a pixel lacks samples");
+        assert!(
+            bytemuck::cast_slice::<_, u8>(&whole_accum) == bytemuck::cast_slice::<_, u8>(&accum(&resumed)),
+            "period {period}: the resumed guided render differs from the uninterrupted one"
+        );
+    }
+}
+
+/// Sample 0 of a guided render comes in two passes: the learner tiles' pixels, rendered with the cosine alone (the
+/// learning pass), then the others with the guide just learned. So the learner pixels' sample 0 equals an
+/// unguided render's bit for bit, and only there is that true of every pixel: the device's tiles are
+/// `env_guide::learner_tile`'s, for periods 4 and 2, and every pixel holds one sample.
+#[test]
+fn sample_zero_is_learned_on_the_learner_tiles_and_guided_elsewhere() {
+    let (w, h) = (96, 96);
     let scene = window_room();
-    let settings = Settings {
-        mode: Mode::Path,
-        max_depth: 3,
-        env_sampling: EnvSampling::Guided,
-        sampler: SamplerKind::Sobol,
-        ..cfg(Strategy::Mis).apply(&small(w, h))
-    };
+    let base = Settings { mode: Mode::Path, max_depth: 3, ..cfg(Strategy::Mis).apply(&small(w, h)) };
     let gs = GpuScene::upload(ctx(), SceneData::build(&scene)).expect("upload");
-    let accum = |r: &Renderer| -> Vec<mislab::gpu::types::GpuAccum> {
+    let one_sample = |settings: Settings, period: u32| -> Vec<mislab::gpu::types::GpuAccum> {
+        let mut r = Renderer::new(ctx(), &gs, scene.camera.clone(), settings).expect("renderer");
+        r.set_guide_learner_period(Some(period));
+        r.render(ctx(), 1).expect("render");
+        eprintln!("period {period}: guide {:?}", r.guide_coverage());
         ctx().read_pod(r.accum_buffer(), (w * h) as usize).expect("readback")
     };
-    let mut whole = Renderer::new(ctx(), &gs, scene.camera.clone(), settings.clone()).expect("renderer");
-    whole.render(ctx(), 6).expect("render");
-    let mut first = Renderer::new(ctx(), &gs, scene.camera.clone(), settings.clone()).expect("renderer");
-    first.render(ctx(), 2).expect("render");
-    let mut resumed = Renderer::new(ctx(), &gs, scene.camera.clone(), settings).expect("renderer");
-    resumed.restore(&accum(&first), 2, first.nonfinite_total(), first.rays_total()).expect("restore");
-    resumed.render(ctx(), 4).expect("render");
-    assert_eq!(resumed.samples(), 6);
-    assert!(whole.guide_coverage().is_some_and(|(g, _)| g > 0), "the guide learned nothing");
-    assert_eq!(whole.guide_coverage(), resumed.guide_coverage(), "the resumed render learned another guide");
-    assert!(
-        bytemuck::cast_slice::<_, u8>(&accum(&whole)) == bytemuck::cast_slice::<_, u8>(&accum(&resumed)),
-        "the resumed guided render differs from the uninterrupted one"
-    );
+    let cosine = one_sample(Settings { env_sampling: EnvSampling::Importance, ..base.clone() }, 4);
+    for period in [4, 2, 1] {
+        let guided = one_sample(Settings { env_sampling: EnvSampling::Guided, ..base.clone() }, period);
+        let (mut learners, mut others, mut others_differing) = (0, 0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let (g, c) = (guided[i], cosine[i]);
+                assert_eq!(g.count + g.nonfinite, 1, "period {period}: pixel ({x}, {y}) holds no sample 0");
+                let same = bytemuck::bytes_of(&g) == bytemuck::bytes_of(&c);
+                if mislab::render::env_guide::learner_tile(x / 8, y / 8, period) {
+                    learners += 1;
+                    assert!(same, "period {period}: learner pixel ({x}, {y}) is not the cosine's sample 0");
+                } else {
+                    others += 1;
+                    others_differing += (!same) as u32;
+                }
+            }
+        }
+        eprintln!(
+            "period {period}: {learners} learner pixels, {others_differing} of {others} others guided differently"
+        );
+        assert_eq!(learners * period, w * h, "period {period}: one tile in {period} learns");
+        // A pixel whose paths meet no guided slot renders as the cosine does; most of the room's do not.
+        assert!(others_differing > 0 || period == 1, "period {period}: the other pixels were not guided");
+    }
 }

@@ -142,7 +142,11 @@ fn shared_structs_match() {
             guide_inv_cell,
             guide_slots,
             guide_dims,
-            guide_on
+            guide_on,
+            guide_learner_period,
+            _pad_guide0,
+            _pad_guide1,
+            _pad_guide2
         ]
     );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
@@ -218,6 +222,7 @@ fn tag_constants_match() {
         ("GUIDE_BINS", mislab::render::env_guide::BINS as u32),
         ("GUIDE_LEARN", mislab::render::env_guide::LEARN),
         ("GUIDE_LEARN_ONLY", mislab::render::env_guide::LEARN_ONLY),
+        ("GUIDE_COMPLETE", mislab::render::env_guide::COMPLETE),
     ] {
         assert_eq!(wgsl_const(&m, name), v, "{name} differs between WGSL and Rust");
     }

@@ -233,7 +233,8 @@ pub struct GpuFrameParams {
     /// The environment guide's grid: lower corner (render-origin space), 1 / cell size, cells per axis
     /// (`render::env_guide`).
     pub guide_min: [f32; 3],
-    /// > 0: the guide's learning pass (1: its samples also accumulate; 2: it only counts).
+    /// > 0: the guide's learning pass (1: its samples also accumulate; 2: it only counts) or, 3, the rest of
+    /// sample 0 after a learning pass over the learner tiles only (`render::env_guide`).
     pub guide_train: u32,
     pub guide_inv_cell: [f32; 3],
     /// The guide's slots (cells × 6 normal classes).
@@ -241,6 +242,11 @@ pub struct GpuFrameParams {
     pub guide_dims: [u32; 3],
     /// 1 once a guide is learned.
     pub guide_on: u32,
+    /// One 8×8 tile in this many learns the guide (1, 2 or 4; `env_guide::learner_period`).
+    pub guide_learner_period: u32,
+    pub _pad_guide0: u32,
+    pub _pad_guide1: u32,
+    pub _pad_guide2: u32,
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

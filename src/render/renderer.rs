@@ -92,8 +92,11 @@ pub struct Renderer {
     guide_on: bool,
     /// Slots of the learned guide that draw from it (alpha > 0).
     guided_slots: usize,
-    /// What the next dispatch does for the guide (0: uses it; `env_guide::LEARN`, `LEARN_ONLY`: learns it).
+    /// What the next dispatch does for the guide (0: uses it; `env_guide::LEARN`, `LEARN_ONLY`: learns it;
+    /// `COMPLETE`: renders the rest of sample 0 with it).
     guide_train: u32,
+    /// One 8×8 tile in this many learns the guide, instead of the film size's choice (`set_guide_learner_period`).
+    guide_learner_period: Option<u32>,
     /// Whether the scene's environment is one constant (the only kind the guide serves).
     env_is_constant: bool,
 }
@@ -242,6 +245,7 @@ impl Renderer {
             guide_counts,
             guide_on: false,
             guide_train: 0,
+            guide_learner_period: None,
             guided_slots: 0,
             env_is_constant,
         };
@@ -510,6 +514,10 @@ impl Renderer {
             guide_slots: self.guide_grid.slots() as u32,
             guide_dims: self.guide_grid.dims.into(),
             guide_on: self.guide_on as u32,
+            guide_learner_period: self.guide_learner_period(),
+            _pad_guide0: 0,
+            _pad_guide1: 0,
+            _pad_guide2: 0,
         }
     }
 

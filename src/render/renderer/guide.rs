@@ -22,25 +22,36 @@ impl Renderer {
         self.guide_on.then_some((self.guided_slots, self.guide_grid.slots()))
     }
 
+    /// One 8×8 tile in this many learns the guide (`env_guide::learner_period` of the film unless set).
+    pub fn guide_learner_period(&self) -> u32 {
+        self.guide_learner_period
+            .unwrap_or_else(|| env_guide::learner_period(self.settings.width as u64 * self.settings.height as u64))
+    }
+
+    /// Sets how many 8×8 tiles share one learner (1, 2 or 4; None: the film size decides), so that a test can
+    /// exercise learner tiles on a small film; resets.
+    pub fn set_guide_learner_period(&mut self, period: Option<u32>) {
+        assert!(period.is_none_or(|p| matches!(p, 1 | 2 | 4)), "learner period {period:?}: 1, 2 or 4");
+        self.guide_learner_period = period;
+        self.reset();
+    }
+
     /// Learns the environment guide for the current camera and settings if they want one and it is not learned
-    /// yet (`env_guide`): sample 0 of every pixel, rendered with the cosine alone, counts where the sky was seen;
-    /// the counts are read back and the CDFs uploaded. At sample 0 that pass is the render's first sample; a
-    /// render resumed (or a part started) past it renders sample 0 again, counting only, and so learns the same
-    /// guide: the image does not depend on where a render was stopped or split. The pipeline must be built
-    /// (`prepare`); a band pass in flight waits for its end.
+    /// yet (`env_guide`): sample 0 of the learner tiles' pixels, rendered with the cosine alone, counts where the
+    /// sky was seen; the counts are read back and the CDFs uploaded. At sample 0 that pass is the learner pixels'
+    /// first sample, and the other pixels' sample 0 follows at once, guided (`env_guide::COMPLETE`): sample 0 is
+    /// then complete. A render resumed (or a part started) past it renders the learners' sample 0 again, counting
+    /// only, and so learns the same guide: the image does not depend on where a render was stopped or split. The
+    /// pipeline must be built (`prepare`); a band pass in flight waits for its end.
     pub fn ensure_guide(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
         if self.guide_on || self.pass.is_some() || !self.wants_guide() {
             return Ok(());
         }
+        let first = self.samples == 0;
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.guide_counts, 0, None);
-        if self.samples == 0 {
-            self.guide_train = env_guide::LEARN;
-            self.record(&mut enc, 1, None);
-        } else {
-            self.guide_train = env_guide::LEARN_ONLY;
-            self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, None);
-        }
+        self.guide_train = if first { env_guide::LEARN } else { env_guide::LEARN_ONLY };
+        self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, None);
         self.guide_train = 0;
         self.queue.submit([enc.finish()]);
         ctx.wait()?;
@@ -51,6 +62,16 @@ impl Renderer {
         self.guided_slots = cdfs.chunks_exact(env_guide::BINS).filter(|c| c[env_guide::BINS - 1] > 0.0).count();
         self.queue.write_buffer(&self.guide_cdf, 0, bytemuck::cast_slice(&cdfs));
         self.guide_on = true;
+        if first {
+            // The rest of sample 0, with the guide (the write above reaches the queue before this submission).
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            self.guide_train = env_guide::COMPLETE;
+            self.record(&mut enc, 1, None);
+            self.guide_train = 0;
+            self.queue.submit([enc.finish()]);
+            ctx.wait()?;
+            self.collect_counters(ctx)?;
+        }
         Ok(())
     }
 }
