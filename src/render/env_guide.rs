@@ -45,8 +45,9 @@ pub fn learner_period(pixels: u64) -> u32 {
 /// in every row and every column of tiles, so that the learners spread evenly over the image and over every run of
 /// tile rows a thread renders.
 pub fn learner_tile(tx: u32, ty: u32, period: u32) -> bool {
-    (tx + ty) % period.max(1) == 0
+    (tx + ty).is_multiple_of(period.max(1))
 }
+
 /// Bands of w.y in a slot's direction bins.
 pub const Z_BINS: usize = 8;
 /// Sectors of φ = atan2(w.z, w.x) in a slot's direction bins.
