@@ -1217,6 +1217,31 @@ fn a_guided_render_resumed_past_its_first_sample_continues_bit_for_bit() {
     }
 }
 
+/// Benchmarks time a guided render's sample 0 too: its learning pass and the pass that completes it run inside
+/// `ensure_guide`, and `render_timed` times them with the GPU timer like every other pass (they once went untimed:
+/// `mislab bench` then printed billions of samples a second for a 1-spp rung).
+#[test]
+fn a_timed_guided_render_counts_its_first_sample() {
+    let (w, h) = (96, 96);
+    let scene = window_room();
+    let settings = Settings {
+        mode: Mode::Path,
+        max_depth: 3,
+        env_sampling: EnvSampling::Guided,
+        ..cfg(Strategy::Mis).apply(&small(w, h))
+    };
+    let gs = GpuScene::upload(ctx(), SceneData::build(&scene)).expect("upload");
+    let mut r = Renderer::new(ctx(), &gs, scene.camera.clone(), settings).expect("renderer");
+    r.set_guide_learner_period(Some(4));
+    let mut timer = mislab::gpu::timer::GpuTimer::new(ctx(), 16).expect("lavapipe offers timestamp queries");
+    let first = r.render_timed(ctx(), 1, Some(&mut timer)).expect("render");
+    let second = r.render_timed(ctx(), 1, Some(&mut timer)).expect("render");
+    assert!(r.guide_coverage().is_some(), "no guide was learned");
+    let (g0, g1) = (first.gpu.expect("GPU time"), second.gpu.expect("GPU time"));
+    eprintln!("GPU seconds: sample 0 {g0:.4}, sample 1 {g1:.4}");
+    assert!(g0 > 0.5 * g1, "sample 0 took {g0} s of GPU time against {g1} s for sample 1");
+}
+
 /// Sample 0 of a guided render comes in two passes: the learner tiles' pixels, rendered with the cosine alone (the
 /// learning pass), then the others with the guide just learned. So the learner pixels' sample 0 equals an
 /// unguided render's bit for bit, and only there is that true of every pixel: the device's tiles are

@@ -2,6 +2,7 @@
 //! it from sample 0, and how much of it is used.
 
 use super::Renderer;
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::env_guide;
 use crate::render::settings::{EnvSampling, Strategy};
@@ -44,6 +45,11 @@ impl Renderer {
     /// only, and so learns the same guide: the image does not depend on where a render was stopped or split. The
     /// pipeline must be built (`prepare`); a band pass in flight waits for its end.
     pub fn ensure_guide(&mut self, ctx: &GpuContext) -> Result<(), GpuError> {
+        self.ensure_guide_timed(ctx, None)
+    }
+
+    /// `ensure_guide`, its passes timed by `timer` (benchmarks: `render_timed`).
+    pub fn ensure_guide_timed(&mut self, ctx: &GpuContext, mut timer: Option<&mut GpuTimer>) -> Result<(), GpuError> {
         if self.guide_on || self.pass.is_some() || !self.wants_guide() {
             return Ok(());
         }
@@ -51,7 +57,8 @@ impl Renderer {
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.guide_counts, 0, None);
         self.guide_train = if first { env_guide::LEARN } else { env_guide::LEARN_ONLY };
-        self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, None);
+        let writes = timer.as_deref_mut().and_then(|t| t.pass());
+        self.dispatch(&mut enc, 1, self.window.start, self.window.len() as u32, writes);
         self.guide_train = 0;
         self.queue.submit([enc.finish()]);
         ctx.wait()?;
@@ -66,7 +73,7 @@ impl Renderer {
             // The rest of sample 0, with the guide (the write above reaches the queue before this submission).
             let mut enc = self.device.create_command_encoder(&Default::default());
             self.guide_train = env_guide::COMPLETE;
-            self.record(&mut enc, 1, None);
+            self.record(&mut enc, 1, timer);
             self.guide_train = 0;
             self.queue.submit([enc.finish()]);
             ctx.wait()?;

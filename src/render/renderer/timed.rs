@@ -37,11 +37,11 @@ impl Renderer {
         self.prepare()?;
         let mut timing = Timing { gpu: timer.as_ref().map(|_| 0.0), ..Timing::default() };
         let rays_before = self.rays_total;
-        // The guide's learning pass may be this call's first sample (timed like the others, without the GPU timer).
+        // The guide's learning pass and the rest of sample 0 may be this call's first sample (timed like the others).
         let before = self.samples;
         if spp > 0 {
             let t0 = Instant::now();
-            self.ensure_guide(ctx)?;
+            self.ensure_guide_timed(ctx, timer.as_deref_mut())?;
             timing.wall += t0.elapsed().as_secs_f64();
         }
         let chunk = self.max_dispatch_spp();
@@ -63,6 +63,10 @@ impl Renderer {
                 // Also bounds the device's 32-bit ray counter between readbacks.
                 self.collect_counters(ctx)?;
             }
+        }
+        // The guide's passes, where they were all this call rendered.
+        if let (Some(t), Some(g)) = (timer.as_deref_mut(), timing.gpu.as_mut()) {
+            *g += t.read(ctx)?.iter().sum::<f64>();
         }
         timing.rays = self.rays_total - rays_before;
         Ok(timing)
