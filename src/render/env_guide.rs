@@ -2,14 +2,15 @@
 //! learned from the render's first sample, for the light technique's sky samples.
 //!
 //! Inside a room a constant sky is seen through the windows only: most cosine-distributed shadow rays towards it
-//! are blocked, and that is most of the interiors' error (docs/estimators.md, "Environment guide"). The render's
-//! sample 0 (its *learning pass*, rendered with the cosine alone) counts, per *slot* — a cell of a grid over the
+//! are blocked, and that is most of the interiors' error (docs/estimators.md, "Environment guide"). Sample 0 of
+//! the learner tiles (its *learning pass*, rendered with the cosine alone; one 8×8 tile in [`learner_period`])
+//! counts, per *slot* — a cell of a grid over the
 //! scene × the dominant axis of the receiver's normal — its shadow rays towards the sky, those that reached it,
 //! and the direction bins in which they and the paths' continuations reached it. Each slot's counts, pooled with
 //! its neighbours', become a CDF over [`BINS`] equal-area direction bins and a probability alpha of using it; the
 //! light technique then samples `alpha · guide + (1 − alpha) · cosine` (shaders/env_guide.wgsl; `env_sample` in lights.wgsl), so
 //! every direction the integrand needs keeps a density and the estimate stays unbiased whatever the guide learned.
-//! The guide is a function of the scene, camera, settings and seed only (integer counts of sample 0), so renders
+//! The other pixels' sample 0 follows with the guide ([`COMPLETE`]). The guide is a function of the scene, camera, settings and seed only (integer counts of sample 0), so renders
 //! stay repeatable, and resumed or split ones learn the same guide (`Renderer::ensure_guide`).
 
 use glam::{UVec3, Vec2, Vec3};

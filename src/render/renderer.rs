@@ -471,7 +471,7 @@ impl Renderer {
         GpuFrameParams {
             width: s.width,
             height: s.height,
-            // The guide's learning pass is sample 0, wherever the render stands (`ensure_guide`).
+            // The guide's learning pass is the learners' sample 0, wherever the render stands (`ensure_guide`).
             sample_base: if self.guide_train == env_guide::LEARN_ONLY { 0 } else { self.samples },
             samples_per_dispatch: spp,
             seed: s.seed,

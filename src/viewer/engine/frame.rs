@@ -39,7 +39,7 @@ impl Engine {
                 let (rows, spp) = side.plan(budget);
                 let row0 = side.renderer.pass_row();
                 let spp = side.renderer.pass_spp().unwrap_or(spp);
-                // A guided render learns its environment guide before its first band (one short dispatch).
+                // A guided render learns its environment guide and completes sample 0 before its first band.
                 side.renderer.ensure_guide(&self.ctx)?;
                 side.renderer.record_band(&mut enc, spp, rows, timer);
                 dispatches.push((i, Dispatch::Band { row0, rows, spp }));
