@@ -24,6 +24,8 @@ const LIGHT_POINT: u32 = 3u;
 const LIGHT_SPOT: u32 = 4u;
 const LIGHT_DIRECTIONAL: u32 = 5u;
 const LIGHT_ENVIRONMENT: u32 = 6u;
+const LIGHT_CONVEX_LAMP: u32 = 7u;   // a closed convex emitter mesh sampled as one light (lights.wgsl)
+const LIGHT_LAMP_FACE: u32 = 8u;     // one face of a convex lamp: found by rays, never chosen (tree_trail: its lamp)
 
 // Settings tags (mirrored by the Rust enums in src/render/settings.rs).
 const MODE_DIRECT: u32 = 0u;
@@ -163,7 +165,7 @@ struct Light {
     cos_outer: f32,
     area: f32,
     pmf_uniform: f32,
-    tree_trail: u32,       // the light's root-to-leaf path in light_tree (bit k: second child at depth k)
+    tree_trail: u32,       // the light's root-to-leaf path in light_tree (bit k: second child at depth k); a lamp face's lamp
     two_sided: u32,        // 1: an area light emitting from both faces (triangles, quads)
     shadow_box: u32,       // 1: a triangle of an isolated emitter; position/direction hold its stop box (lo/hi)
     _pad2: u32,
@@ -315,6 +317,7 @@ override HAS_QUADS: bool = true;
 override HAS_TRIANGLE_LIGHTS: bool = true;
 override HAS_SPHERE_LIGHTS: bool = true;
 override HAS_QUAD_LIGHTS: bool = true;
+override HAS_CONVEX_LAMPS: bool = true;
 override HAS_DELTA_LIGHTS: bool = true;
 /// 0: no environment, 1: constant, 2: equirectangular map, 3: either (generic).
 override ENV_KIND: u32 = 3u;

@@ -310,7 +310,9 @@ fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, from_n: vec
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
         p_light = light_pdf_li(found.light, m, from_p, env_receiver(from_n, from_transmits), w, found.surface.p, found.surface.ng);
     }
-    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(found.light, from_p, from_n) * p_light);
+    // A convex lamp's face was found: the lamp is what light sampling chooses.
+    let chosen = chosen_light(found.light);
+    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(chosen, from_p, from_n) * p_light);
 }
 
 // ---- shade() ----

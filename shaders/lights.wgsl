@@ -433,6 +433,101 @@ fn sphere_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3
 
 fn sphere_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(l, y); }
 
+// ---- LIGHT_CONVEX_LAMP: a closed, convex, round emitter mesh as one light (src/accel/convex_lamps.rs) ----
+//
+// A lamp's fields: position / direction its stop box (lo / hi, shadow_box = 1), whose centre is the centre of the
+// sphere inside the mesh; cos_inner that sphere's radius; cos_outer the rim probability; prim the light index of its
+// first face (LIGHT_LAMP_FACE, the faces follow each other); area the number of faces; radiance the emission.
+// A LIGHT_LAMP_FACE is a face's triangle light (prim, area, stop box) with tree_trail = its lamp. Rays find faces;
+// light samples choose lamps.
+
+fn lamp_center(l: Light) -> vec3<f32> { return 0.5 * (l.position + l.direction); }
+
+/// 1 − cosθmax of the cone of the lamp's inner sphere from p, or a negative value where p is not outside it.
+fn lamp_cone_one_minus_cos(l: Light, p: vec3<f32>) -> f32 {
+    let v = lamp_center(l) - p;
+    let d2 = dot(v, v);
+    let r2 = l.cos_inner * l.cos_inner;
+    if (!(d2 > r2 * 1.0001)) { return -1.0; }
+    let sin2 = r2 / d2;
+    return sin2 / (1.0 + sqrt(1.0 - sin2));
+}
+
+/// Whether direction w from p meets the lamp's inner sphere.
+fn lamp_in_cone(l: Light, p: vec3<f32>, w: vec3<f32>) -> bool {
+    let v = lamp_center(l) - p;
+    let t = dot(v, w);
+    return t > 0.0 && dot(v, v) - t * t <= l.cos_inner * l.cos_inner;
+}
+
+/// Solid-angle mode (p outside the inner sphere): the cone, omega its solid angle, and the rim; else by area.
+fn convex_lamp_measure(l: Light, p: vec3<f32>) -> LightMeasure {
+    let omc = lamp_cone_one_minus_cos(l, p);
+    if (cfg_light_sampling() == LIGHT_SAMPLING_SOLID_ANGLE && omc > 0.0) {
+        return LightMeasure(MEASURE_SOLID_ANGLE, TWO_PI * omc);
+    }
+    return LightMeasure(MEASURE_AREA, 0.0);
+}
+
+/// Probability of drawing a face by area: the rim's in solid-angle mode, every sample by area.
+fn lamp_by_area_share(l: Light, m: LightMeasure) -> f32 {
+    return select(1.0, l.cos_outer, m.measure == MEASURE_SOLID_ANGLE);
+}
+
+/// With probability 1 − rim a direction uniformly in the inner sphere's cone (it meets the mesh; the shadow ray
+/// stops at the stop box, so the point aimed at is the inner sphere's); else a face uniformly and a point on it by
+/// area, kept only outside the cone (the rim). By area (area mode): every sample a face and a point, none dropped.
+fn convex_lamp_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample {
+    let m = convex_lamp_measure(l, p);
+    let by_area = lamp_by_area_share(l, m);
+    let faces = u32(l.area);
+    if (u.z < by_area) {
+        let k = min(u32(u.z / by_area * f32(faces)), faces - 1u);
+        var s = triangle_sample_area(scene_light(l.prim + k), p, u.xy);
+        if (!(s.pdf > 0.0) || (m.measure == MEASURE_SOLID_ANGLE && lamp_in_cone(l, p, s.wi))) {
+            return no_light_sample_in(m);
+        }
+        s.pdf *= by_area / f32(faces);
+        s.m = m;
+        return s;
+    }
+    let omc = m.omega * INV_TWO_PI;
+    let to_c = lamp_center(l) - p;
+    let d = length(to_c);
+    let wl = square_to_uniform_cone(u.xy, omc);
+    let wi = normalize(to_world(frame_from_normal(to_c / d), wl));
+    let sin2 = wl.x * wl.x + wl.y * wl.y;
+    let t = max(d * wl.z - safe_sqrt(l.cos_inner * l.cos_inner - d * d * sin2), 0.0);
+    // Any face's triangle leads the shadow ray to the stop box (estimators.wgsl `stop_box_entry`).
+    let prim = make_prim(PRIM_TRIANGLE, scene_light(l.prim).prim);
+    return LightSample(wi, t, l.radiance, (1.0 - by_area) / m.omega, m, prim);
+}
+
+/// Rays find a lamp's faces, not the lamp: no pdf of its own (its faces' is the lamp's), no emission.
+fn convex_lamp_pdf_li(l: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 { return 0.0; }
+fn convex_lamp_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return vec3<f32>(0.0); }
+
+// ---- LIGHT_LAMP_FACE: one face of a convex lamp (never chosen: its lamp is) ----
+
+fn lamp_face_measure(l: Light, p: vec3<f32>) -> LightMeasure { return convex_lamp_measure(scene_light(l.tree_trail), p); }
+fn lamp_face_sample_li(l: Light, p: vec3<f32>, u: vec3<f32>) -> LightSample { return no_light_sample(); }
+fn lamp_face_eval(l: Light, y: Surface, wi: vec3<f32>) -> vec3<f32> { return area_eval(l, y); }
+
+/// pdf that the lamp of `face` draws wi from p, meeting `face` at y (n_y), given m = its lamp's measure from p.
+fn lamp_face_pdf_li(face: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y: vec3<f32>, n_y: vec3<f32>) -> f32 {
+    if (m.measure != MEASURE_SOLID_ANGLE && m.measure != MEASURE_AREA) { return 0.0; }
+    let l = scene_light(face.tree_trail);
+    let by_area = lamp_by_area_share(l, m);
+    if (m.measure == MEASURE_SOLID_ANGLE && lamp_in_cone(l, p, wi)) { return (1.0 - by_area) / m.omega; }
+    return by_area / l.area * triangle_pdf_li(face, LightMeasure(MEASURE_AREA, 0.0), p, wi, y, n_y);
+}
+
+/// The light a light found by a ray counts as when chosen: a lamp's face (the entries from num_lights on) its lamp.
+fn chosen_light(i: u32) -> u32 {
+    if (!HAS_CONVEX_LAMPS || i == INVALID || i < params.num_lights) { return i; }
+    return scene_light(i).tree_trail;
+}
+
 // ---- LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL: delta lights (light sampling alone finds them) ----
 
 /// Point light: irradiance-like radiance I/d², pdf 1 (delta).
@@ -601,6 +696,8 @@ fn light_sample_li(i: u32, p: vec3<f32>, n: vec3<f32>, u: vec3<f32>) -> LightSam
         case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_sample_li(l, p, u); } }
         case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_sample_li(l, p, u); } }
         case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_sample_li(l, p, n, u); } }
+        case LIGHT_CONVEX_LAMP: { if (HAS_CONVEX_LAMPS) { return convex_lamp_sample_li(l, p, u); } }
+        case LIGHT_LAMP_FACE: { if (HAS_CONVEX_LAMPS) { return lamp_face_sample_li(l, p, u); } }
         default: {}
     }
     return no_light_sample();
@@ -617,6 +714,8 @@ fn light_measure(i: u32, p: vec3<f32>) -> LightMeasure {
         case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_measure(l, p); } }
         case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_measure(l, p); } }
         case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_measure(l, p); } }
+        case LIGHT_CONVEX_LAMP: { if (HAS_CONVEX_LAMPS) { return convex_lamp_measure(l, p); } }
+        case LIGHT_LAMP_FACE: { if (HAS_CONVEX_LAMPS) { return lamp_face_measure(l, p); } }
         default: {}
     }
     return LightMeasure(MEASURE_NONE, 0.0);
@@ -634,6 +733,8 @@ fn light_pdf_li(i: u32, m: LightMeasure, p: vec3<f32>, n: vec3<f32>, wi: vec3<f3
         case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_pdf_li(l, m, p, wi, y, n_y); } }
         case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_pdf_li(l, m, p, wi, y, n_y); } }
         case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_pdf_li(l, m, p, n, wi); } }
+        case LIGHT_CONVEX_LAMP: { if (HAS_CONVEX_LAMPS) { return convex_lamp_pdf_li(l, m, p, wi, y, n_y); } }
+        case LIGHT_LAMP_FACE: { if (HAS_CONVEX_LAMPS) { return lamp_face_pdf_li(l, m, p, wi, y, n_y); } }
         default: {}
     }
     return 0.0;
@@ -650,6 +751,8 @@ fn light_eval(i: u32, y: Surface, wi: vec3<f32>) -> vec3<f32> {
         case LIGHT_SPOT: { if (HAS_DELTA_LIGHTS) { return spot_eval(l, y, wi); } }
         case LIGHT_DIRECTIONAL: { if (HAS_DELTA_LIGHTS) { return directional_eval(l, y, wi); } }
         case LIGHT_ENVIRONMENT: { if (ENV_KIND != 0u) { return environment_eval(l, y, wi); } }
+        case LIGHT_CONVEX_LAMP: { if (HAS_CONVEX_LAMPS) { return convex_lamp_eval(l, y, wi); } }
+        case LIGHT_LAMP_FACE: { if (HAS_CONVEX_LAMPS) { return lamp_face_eval(l, y, wi); } }
         default: {}
     }
     return vec3<f32>(0.0);

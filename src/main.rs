@@ -250,7 +250,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         scene.quads.len(),
         scene.materials.len(),
         scene.textures.len(),
-        data.lights.len(),
+        data.selectable_lights(),
         data.bvh_node_count(),
         data.bvh_seconds * 1e3,
         data.bvh_bytes() as f64 / (1 << 20) as f64,
@@ -369,7 +369,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             scene.quads.len(),
             scene.materials.len(),
             scene.textures.len(),
-            data.lights.len(),
+            data.selectable_lights(),
             data.delta_lights,
             match &scene.environment {
                 Environment::None => "none".to_string(),
@@ -377,6 +377,13 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
                 Environment::Map { map, .. } => format!("map {} ({}x{})", map.path.display(), map.width, map.height),
             }
         );
+        let lamps = data.convex_lamps();
+        if lamps > 0 {
+            println!(
+                "convex lamps: {lamps}, {} faces in all; each is one light, sampled through the cone of a sphere inside it",
+                data.lamp_faces
+            );
+        }
         let boxed: Vec<_> = data.lights.iter().filter(|l| l.shadow_box == 1).collect();
         if !boxed.is_empty() {
             let mut meshes: Vec<[u32; 6]> = boxed
@@ -391,7 +398,7 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
             meshes.dedup();
             println!(
                 "isolated emitters: {} triangle lights in {} meshes; shadow rays towards them stop at the mesh's box",
-                boxed.len(),
+                boxed.len() - lamps,
                 meshes.len()
             );
         }

@@ -12,33 +12,7 @@ use mislab::render::settings::{LightSelect, Mode, Settings, Strategy};
 use mislab::render::Renderer;
 use mislab::scene::{Camera, Material, Mesh, Scene};
 
-/// A UV sphere of `rings` × `segs` quads, wound outwards (or inwards), its poles fans. The seam's vertices at
-/// φ = 2π are computed, not copied from φ = 0, so they differ from them in the last bits, as exported meshes' do.
-fn uv_sphere(c: Vec3, r: f32, rings: u32, segs: u32, outward: bool) -> Vec<[Vec3; 3]> {
-    let p = |i: u32, j: u32| {
-        let (th, ph) = (std::f32::consts::PI * i as f32 / rings as f32, std::f32::consts::TAU * j as f32 / segs as f32);
-        c + r * Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
-    };
-    let mut tris = vec![];
-    for i in 0..rings {
-        for j in 0..segs {
-            let (a, b, cc, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
-            if i > 0 {
-                tris.push([a, cc, d]);
-            }
-            if i + 1 < rings {
-                tris.push([a, b, cc]);
-            }
-        }
-    }
-    for t in &mut tris {
-        let n = (t[1] - t[0]).cross(t[2] - t[0]);
-        if (n.dot(t[0] - c) > 0.0) != outward {
-            t.swap(1, 2);
-        }
-    }
-    tris
-}
+use common::uv_sphere;
 
 fn one_sided(_: usize) -> Option<bool> {
     Some(false)
@@ -178,7 +152,9 @@ fn shadow_rays_that_stop_at_the_box_see_every_occluder() {
 
 fn same_pixels_with_and_without_stop_boxes(far: bool) {
     let (scene, n) = sphere_over_plates(far);
-    let data = SceneData::build(&scene);
+    // The lamp's triangles as lights of their own: a convex lamp's samples need its stop box (tests/estimators.rs
+    // `convex_lamps_agree_with_their_triangles`).
+    let data = SceneData::build_with(&scene, false);
     let boxed = data.lights.iter().filter(|l| l.shadow_box == 1).count();
     assert_eq!(boxed, n, "every triangle of the lamp has its stop box");
     let lamp_x = data.lights[0].position[0].abs();
@@ -215,4 +191,57 @@ fn same_pixels_with_and_without_stop_boxes(far: bool) {
         // A missed plate shadow differs by whole samples (a stop 3 % short: 0.22).
         assert!((worst as f64) < 5e-3 * mean, "a pixel differs by {worst} (image mean {mean})");
     }
+}
+
+/// A round closed emitter becomes one convex lamp (src/accel/convex_lamps.rs): its inner sphere inside the mesh and
+/// about its centre; meshes with few faces, flat ones and elongated ones stay triangles.
+#[test]
+fn round_closed_emitters_become_convex_lamps() {
+    use mislab::accel::convex_lamps::{convex_lamp, rim_probability, MIN_FACES};
+    let c = Vec3::new(1.0, 2.0, -3.0);
+    let sphere = uv_sphere(c, 0.5, 24, 48, true);
+    let mesh = &isolated(&sphere, sphere.len(), &[])[0];
+    let lamp = convex_lamp(&sphere, mesh).expect("a fine UV sphere is a lamp");
+    assert!((lamp.center - c).length() < 1e-5, "centre {} (sphere at {c})", lamp.center);
+    // Faces of a UV sphere of 24 rings lie at least r·cos²(π/48) from the centre.
+    let cos = (std::f32::consts::PI / 48.0).cos();
+    assert!(lamp.r_in < 0.5 && lamp.r_in > 0.5 * cos * cos * 0.999, "inner radius {}", lamp.r_in);
+    for t in &sphere {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        assert!(n.dot(t[0] - lamp.center) >= lamp.r_in, "a face cuts the inner sphere");
+    }
+    assert_eq!(lamp.rim, rim_probability(lamp.r_in as f64, 0.5) as f32, "rim from the radii");
+    assert!(lamp.rim == 1.0 / 64.0, "a fine sphere's rim share is the floor, not {}", lamp.rim);
+    let coarse = uv_sphere(c, 0.5, 6, 12, true);
+    let lamp = convex_lamp(&coarse, &isolated(&coarse, coarse.len(), &[])[0]).expect("6 × 12 is round enough");
+    assert!(lamp.rim > 0.1 && lamp.rim < 0.2, "a coarse sphere's rim share {}", lamp.rim);
+    // Too few faces: an octahedron-like 2 × 4 sphere (8 faces); too flat or elongated: a squashed sphere.
+    let octa = uv_sphere(c, 0.5, 2, 4, true);
+    assert!(octa.len() < MIN_FACES);
+    assert_eq!(convex_lamp(&octa, &isolated(&octa, octa.len(), &[])[0]), None);
+    let flat: Vec<[Vec3; 3]> = sphere.iter().map(|t| t.map(|p| c + (p - c) * Vec3::new(1.0, 0.2, 1.0))).collect();
+    assert_eq!(convex_lamp(&flat, &isolated(&flat, flat.len(), &[])[0]), None, "a disc-like solid");
+}
+
+/// The light table with a convex lamp: the lamp is chosen among the other lights, its faces follow them, each
+/// face's triangle finds its face and each face its lamp.
+#[test]
+fn a_convex_lamps_faces_follow_the_lights_that_are_chosen() {
+    use mislab::gpu::types::{LIGHT_CONVEX_LAMP, LIGHT_LAMP_FACE};
+    let (scene, n) = sphere_over_plates(false);
+    let d = SceneData::build_with(&scene, true);
+    assert_eq!((d.selectable_lights(), d.lamp_faces), (1, n));
+    let lamp = d.lights[0];
+    assert_eq!((lamp.kind, lamp.prim, lamp.area as usize, lamp.shadow_box), (LIGHT_CONVEX_LAMP, 1, n, 1));
+    assert_eq!((lamp.pmf_power, lamp.pmf_uniform), (1.0, 1.0));
+    for (t, s) in d.tri_shading.iter().enumerate().filter(|(_, s)| s.light != INVALID) {
+        let face = d.lights[s.light as usize];
+        assert!(s.light >= 1, "triangle {t} points at a chosen light");
+        assert_eq!((face.kind, face.prim as usize, face.tree_trail), (LIGHT_LAMP_FACE, t, 0));
+        assert_eq!((face.position, face.direction), (lamp.position, lamp.direction), "the lamp's stop box");
+    }
+    let faces = d.tri_shading.iter().filter(|s| s.light != INVALID).count();
+    assert_eq!(faces, n);
+    let without = SceneData::build_with(&scene, false);
+    assert_eq!((without.selectable_lights(), without.lamp_faces), (n, 0));
 }

@@ -27,6 +27,10 @@ pub const LIGHT_POINT: u32 = 3;
 pub const LIGHT_SPOT: u32 = 4;
 pub const LIGHT_DIRECTIONAL: u32 = 5;
 pub const LIGHT_ENVIRONMENT: u32 = 6;
+/// A convex lamp (`accel::convex_lamps`): a closed convex emitter mesh sampled as one light.
+pub const LIGHT_CONVEX_LAMP: u32 = 7;
+/// One face of a convex lamp: found by rays, never chosen itself (its lamp is).
+pub const LIGHT_LAMP_FACE: u32 = 8;
 
 /// Texture wrap modes (`TextureInfo::wrap_s`/`wrap_t`).
 pub const WRAP_REPEAT: u32 = 0;

@@ -35,6 +35,8 @@ pub struct Features {
     pub quad_lights: bool,
     /// Point, spot or directional lights.
     pub delta_lights: bool,
+    /// Convex lamps (`accel::convex_lamps`).
+    pub convex_lamps: bool,
     /// Environment kind.
     pub env: EnvKind,
     /// Any texture.
@@ -84,6 +86,7 @@ impl Features {
             sphere_lights: true,
             quad_lights: true,
             delta_lights: true,
+            convex_lamps: true,
             env: EnvKind::Any,
             textures: true,
             checkerboard: true,
@@ -119,10 +122,12 @@ impl Features {
             triangles: !data.tri_shading.is_empty(),
             spheres: !data.spheres.is_empty(),
             quads: !data.quads.is_empty(),
-            triangle_lights: kinds(LIGHT_TRIANGLE),
+            // A lamp's faces are triangle lights to every ray that finds one.
+            triangle_lights: kinds(LIGHT_TRIANGLE) || kinds(LIGHT_LAMP_FACE),
             sphere_lights: kinds(LIGHT_SPHERE),
             quad_lights: kinds(LIGHT_QUAD),
             delta_lights: kinds(LIGHT_POINT) || kinds(LIGHT_SPOT) || kinds(LIGHT_DIRECTIONAL),
+            convex_lamps: kinds(LIGHT_CONVEX_LAMP),
             env,
             textures: !data.tex_info.is_empty(),
             checkerboard: data.tex_info.iter().any(|t| t.tex_kind == TEX_CHECKERBOARD),
@@ -134,7 +139,7 @@ impl Features {
             coated_diffuse: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_COATED_DIFFUSE),
             dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
             diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
-            many_lights: data.lights.len() > 1,
+            many_lights: data.selectable_lights() > 1,
             wide_bvh: !data.wide_nodes.is_empty(),
             alpha,
             // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
@@ -159,6 +164,7 @@ impl Features {
             ("HAS_SPHERE_LIGHTS", b(self.sphere_lights)),
             ("HAS_QUAD_LIGHTS", b(self.quad_lights)),
             ("HAS_DELTA_LIGHTS", b(self.delta_lights)),
+            ("HAS_CONVEX_LAMPS", b(self.convex_lamps)),
             ("ENV_KIND", self.env as u32 as f64),
             ("HAS_TEXTURES", b(self.textures)),
             ("HAS_CHECKERBOARD", b(self.checkerboard)),
@@ -192,6 +198,7 @@ impl Features {
         on("sphere lights", self.sphere_lights);
         on("quad lights", self.quad_lights);
         on("point/spot/directional lights", self.delta_lights);
+        on("convex lamps", self.convex_lamps);
         on("textures", self.textures);
         on("checkerboard textures", self.checkerboard);
         on("texels over two bindings", self.texel_split);

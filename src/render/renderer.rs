@@ -235,7 +235,7 @@ impl Renderer {
             env_constant: d.env_constant,
             env_scale: d.env_scale,
             env_rotation: d.env_rotation,
-            num_lights: d.lights.len() as u32,
+            num_lights: d.selectable_lights() as u32,
             origin: d.origin,
             offset_scale: d.offset_scale,
             source: render_source_for(d),

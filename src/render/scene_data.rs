@@ -2,7 +2,8 @@
 //! data, light table, textures, environment distribution); `gpu_scene` uploads them.
 
 use crate::accel::bvh;
-use crate::accel::isolated_emitters::isolated_emitters;
+use crate::accel::convex_lamps::{convex_lamp, ConvexLamp};
+use crate::accel::isolated_emitters::{isolated_emitters, IsolatedEmitter};
 use crate::accel::light_tree::{GpuLightNode, LightBounds, LightTree};
 use crate::gpu::types::*;
 use crate::render::lights::{self, luminance};
@@ -54,8 +55,11 @@ pub struct SceneData {
     pub quads: Vec<GpuQuad>,
     /// Materials.
     pub materials: Vec<GpuMaterial>,
-    /// Light table.
+    /// Light table: the lights that selection chooses among, then the `lamp_faces` faces of the convex lamps
+    /// (`accel::convex_lamps`), which rays find but only their lamps are chosen.
     pub lights: Vec<GpuLight>,
+    /// How many entries at the end of `lights` are convex lamps' faces.
+    pub lamp_faces: usize,
     /// Alias table for power-proportional light selection.
     pub light_alias: Vec<GpuAliasEntry>,
     /// The light tree over the lights with a position (`--light-select tree`), depth-first; empty if none.
@@ -118,8 +122,15 @@ pub fn render_origin(scene: &Scene) -> Vec3 {
 }
 
 impl SceneData {
-    /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device.
+    /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device. Convex lamps are made unless
+    /// `MISLAB_CONVEX_LAMPS=0` ([`convex_lamps_on`]).
     pub fn build(scene: &Scene) -> SceneData {
+        SceneData::build_with(scene, convex_lamps_on())
+    }
+
+    /// `build`, making convex lamps of the emitter meshes that qualify (`accel::convex_lamps`) or keeping every
+    /// emissive triangle a light of its own.
+    pub fn build_with(scene: &Scene, convex_lamps: bool) -> SceneData {
         let mut d = SceneData { origin: render_origin(scene), ..SceneData::default() };
         let o = d.origin;
         d.materials = scene.materials.iter().map(gpu_material).collect();
@@ -224,7 +235,7 @@ impl SceneData {
         d.prim_refs = if identity && !bvh.prim_refs.is_empty() { IDENTITY_PRIM_REFS.to_vec() } else { bvh.prim_refs };
         d.wide_nodes = bvh.wide;
         build_textures(scene, &mut d);
-        build_lights(scene, &tris, &mut d);
+        build_lights(scene, &tris, &mut d, convex_lamps);
         d.pack_triangle_records();
         d
     }
@@ -277,6 +288,16 @@ impl SceneData {
     }
 
     /// Material index of triangle `i`.
+    /// How many convex lamps (`accel::convex_lamps`) the light table holds.
+    pub fn convex_lamps(&self) -> usize {
+        self.lights.iter().filter(|l| l.kind == LIGHT_CONVEX_LAMP).count()
+    }
+
+    /// The lights that selection chooses among: the first this many of `lights`.
+    pub fn selectable_lights(&self) -> usize {
+        self.lights.len() - self.lamp_faces
+    }
+
     pub fn tri_material(&self, i: usize) -> u32 {
         word_material(self.shading_verts[self.tri_shading[i].corners[0] as usize].material)
     }
@@ -468,9 +489,9 @@ fn scene_radius(d: &SceneData) -> f64 {
 
 /// Gives the triangle lights of isolated emitter meshes their stop box (`accel::isolated_emitters`): a shadow ray
 /// towards one may end where it enters that box. `MISLAB_SHADOW_BOX=0` turns it off (for A/B runs).
-fn mark_isolated_emitters(tris: &[[Vec3; 3]], d: &SceneData, lights: &mut [GpuLight]) {
+fn mark_isolated_emitters(tris: &[[Vec3; 3]], d: &SceneData, lights: &mut [GpuLight]) -> Vec<IsolatedEmitter> {
     if std::env::var("MISLAB_SHADOW_BOX").is_ok_and(|v| v == "0") {
-        return;
+        return vec![];
     }
     let light_of = |i: usize| d.tri_shading.get(i).map_or(INVALID, |s| s.light);
     let emitter = |i: usize| {
@@ -488,16 +509,114 @@ fn mark_isolated_emitters(tris: &[[Vec3; 3]], d: &SceneData, lights: &mut [GpuLi
         (ps.iter().fold(Vec3::INFINITY, |a, &p| a.min(p)), ps.iter().fold(Vec3::NEG_INFINITY, |a, &p| a.max(p)))
     });
     let others: Vec<(Vec3, Vec3)> = spheres.chain(quads).collect();
-    for mesh in isolated_emitters(tris, emitter, &others) {
-        for t in mesh.triangles {
+    let meshes = isolated_emitters(tris, emitter, &others);
+    for mesh in &meshes {
+        for &t in &mesh.triangles {
             let l = &mut lights[light_of(t) as usize];
             (l.position, l.direction, l.shadow_box) = (mesh.lo.into(), mesh.hi.into(), 1);
+        }
+    }
+    meshes
+}
+
+/// Whether isolated emitter meshes that are closed, convex and round become convex lamps (`accel::convex_lamps`):
+/// `MISLAB_CONVEX_LAMPS=0` keeps their triangles as lights (for A/B runs).
+pub fn convex_lamps_on() -> bool {
+    !std::env::var("MISLAB_CONVEX_LAMPS").is_ok_and(|v| v == "0")
+}
+
+/// Replaces the triangle lights of every convex lamp among `meshes` by one lamp light (appended) and returns the
+/// lamps, each with the lights of its faces (moved out of `lights`; `tri_shading` is repointed in
+/// `append_lamp_faces`). A lamp needs one emission on every face: one material without an emission texture,
+/// one-sided.
+fn make_convex_lamps(
+    tris: &[[Vec3; 3]],
+    d: &mut SceneData,
+    meshes: &[IsolatedEmitter],
+    lights: &mut Vec<GpuLight>,
+    power: &mut Vec<f64>,
+) -> Vec<(u32, Vec<(usize, GpuLight)>)> {
+    let lamps: Vec<ConvexLamp> = meshes
+        .iter()
+        .filter(|m| {
+            let mat = d.tri_material(m.triangles[0]);
+            let gm = &d.materials[mat as usize];
+            gm.emissive_tex == INVALID
+                && m.triangles
+                    .iter()
+                    .all(|&t| d.tri_material(t) == mat && lights[d.tri_shading[t].light as usize].two_sided == 0)
+        })
+        .filter_map(|m| convex_lamp(tris, m))
+        .collect();
+    if lamps.is_empty() {
+        return vec![];
+    }
+    let mut face_of = vec![false; lights.len()];
+    for lamp in &lamps {
+        for &t in &lamp.mesh.triangles {
+            face_of[d.tri_shading[t].light as usize] = true;
+        }
+    }
+    // Keep the other lights in order and repoint their triangles.
+    let mut index = vec![INVALID; lights.len()];
+    let (mut kept, mut kept_power) = (Vec::new(), Vec::new());
+    for (i, (l, p)) in lights.iter().zip(power.iter()).enumerate() {
+        if !face_of[i] {
+            index[i] = kept.len() as u32;
+            kept.push(*l);
+            kept_power.push(*p);
+        }
+    }
+    let old = std::mem::replace(lights, kept);
+    *power = kept_power;
+    for s in d.tri_shading.iter_mut().filter(|s| s.light != INVALID) {
+        if !face_of[s.light as usize] {
+            s.light = index[s.light as usize];
+        }
+    }
+    for l in d.spheres.iter_mut().map(|s| &mut s.light).chain(d.quads.iter_mut().map(|q| &mut q.light)) {
+        if *l != INVALID {
+            *l = index[*l as usize];
+        }
+    }
+    let mut out = Vec::new();
+    for lamp in lamps {
+        let faces: Vec<(usize, GpuLight)> =
+            lamp.mesh.triangles.iter().map(|&t| (t, old[d.tri_shading[t].light as usize])).collect();
+        let area: f64 = faces.iter().map(|(_, l)| l.area as f64).sum();
+        let emission = d.materials[d.tri_material(lamp.mesh.triangles[0]) as usize].emission;
+        power.push(PI * area * luminance(emission));
+        out.push((lights.len() as u32, faces));
+        lights.push(GpuLight {
+            kind: LIGHT_CONVEX_LAMP,
+            position: lamp.mesh.lo.into(),
+            direction: lamp.mesh.hi.into(),
+            shadow_box: 1,
+            radiance: emission,
+            cos_inner: lamp.r_in,
+            cos_outer: lamp.rim,
+            area: lamp.mesh.triangles.len() as f32,
+            ..Default::default()
+        });
+    }
+    out
+}
+
+/// Appends the convex lamps' faces after every light that selection chooses among: each lamp learns where its
+/// faces start (`prim`), each face its lamp (`tree_trail`), each face's triangle its light.
+fn append_lamp_faces(d: &mut SceneData, lights: &mut Vec<GpuLight>, lamps: Vec<(u32, Vec<(usize, GpuLight)>)>) {
+    for (lamp, faces) in lamps {
+        lights[lamp as usize].prim = lights.len() as u32;
+        d.lamp_faces += faces.len();
+        for (t, face) in faces {
+            d.tri_shading[t].light = lights.len() as u32;
+            lights.push(GpuLight { kind: LIGHT_LAMP_FACE, tree_trail: lamp, pmf_power: 0.0, pmf_uniform: 0.0, ..face });
         }
     }
 }
 
 /// Emissive triangles are never pre-split (`keep_whole` above), so each is one light with one copy.
-fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
+fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData, convex_lamps: bool) {
     let mut lights: Vec<GpuLight> = Vec::new();
     let mut power: Vec<f64> = Vec::new();
     let emits = |m: u32| {
@@ -545,7 +664,8 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
         let two_sided = (sides == 2) as u32;
         lights.push(GpuLight { kind: LIGHT_QUAD, prim: i as u32, area, two_sided, ..Default::default() });
     }
-    mark_isolated_emitters(tris, d, &mut lights);
+    let isolated = mark_isolated_emitters(tris, d, &mut lights);
+    let lamps = if convex_lamps { make_convex_lamps(tris, d, &isolated, &mut lights, &mut power) } else { vec![] };
     let r = scene_radius(d);
     // Lights with a position first, then the infinite ones (directional, environment): the light tree covers
     // the first `bounded` entries and the shader finds the infinite ones after them.
@@ -629,6 +749,7 @@ fn build_lights(scene: &Scene, tris: &[[Vec3; 3]], d: &mut SceneData) {
         l.tree_trail = trail;
     }
     d.light_tree = tree.nodes;
+    append_lamp_faces(d, &mut lights, lamps);
     d.lights = lights;
     d.light_alias = table.entries;
 }
@@ -671,6 +792,7 @@ fn light_bounds(l: &GpuLight, power: f64, tris: &[[Vec3; 3]], d: &SceneData) -> 
             let c = Vec3::from(s.center);
             everywhere(c - s.radius, c + s.radius)
         }
+        LIGHT_CONVEX_LAMP => everywhere(l.position.into(), l.direction.into()),
         LIGHT_SPOT => {
             let p = Vec3::from(l.position);
             let (theta_i, theta_o) = (l.cos_inner.clamp(-1.0, 1.0).acos(), l.cos_outer.clamp(-1.0, 1.0).acos());

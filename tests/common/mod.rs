@@ -1,6 +1,7 @@
 //! Helpers shared by the GPU integration tests. A missing adapter is a test FAILURE with a clear message.
 #![allow(dead_code)]
 
+use glam::Vec3;
 use mislab::gpu::GpuContext;
 use mislab::render::film::Film;
 use mislab::render::settings::Settings;
@@ -82,4 +83,32 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
     } else {
         -inverse_normal_cdf(1.0 - p)
     }
+}
+
+/// A UV sphere of `rings` × `segs` quads, wound outwards (or inwards), its poles fans. The seam's vertices at
+/// φ = 2π are computed, not copied from φ = 0, so they differ from them in the last bits, as exported meshes' do.
+pub fn uv_sphere(c: Vec3, r: f32, rings: u32, segs: u32, outward: bool) -> Vec<[Vec3; 3]> {
+    let p = |i: u32, j: u32| {
+        let (th, ph) = (std::f32::consts::PI * i as f32 / rings as f32, std::f32::consts::TAU * j as f32 / segs as f32);
+        c + r * Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
+    };
+    let mut tris = vec![];
+    for i in 0..rings {
+        for j in 0..segs {
+            let (a, b, cc, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+            if i > 0 {
+                tris.push([a, cc, d]);
+            }
+            if i + 1 < rings {
+                tris.push([a, b, cc]);
+            }
+        }
+    }
+    for t in &mut tris {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        if (n.dot(t[0] - c) > 0.0) != outward {
+            t.swap(1, 2);
+        }
+    }
+    tris
 }
