@@ -123,9 +123,9 @@ pub fn render_origin(scene: &Scene) -> Vec3 {
 
 impl SceneData {
     /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device. Convex lamps are made unless
-    /// `MISLAB_CONVEX_LAMPS=0` ([`convex_lamps_on`]).
+    /// `MISLAB_CONVEX_LAMPS=0` ([`convex_lamps_on`]) or the scene keeps its emitter triangles.
     pub fn build(scene: &Scene) -> SceneData {
-        SceneData::build_with(scene, convex_lamps_on())
+        SceneData::build_with(scene, convex_lamps_on() && !scene.emitter_triangles_kept)
     }
 
     /// `build`, making convex lamps of the emitter meshes that qualify (`accel::convex_lamps`) or keeping every

@@ -451,6 +451,9 @@ pub struct Scene {
     pub film_size: Option<[u32; 2]>,
     /// pbrt / Mitsuba imports: what was imported and what was ignored, one line each (`mislab info`).
     pub import_report: Vec<String>,
+    /// Keep every emissive triangle a light of its own even where its mesh could be a convex lamp
+    /// (`accel::convex_lamps`): `veach-mis-triangles`, which is there to show light selection among 80,640 lights.
+    pub emitter_triangles_kept: bool,
 }
 
 impl Scene {
