@@ -145,7 +145,10 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             o0 = vec4<f32>(s.wi, s.pdf);
             if (s.pdf > 0.0) {
                 let y = p + s.dist * s.wi;
-                o1 = vec4<f32>(light_pdf_li(probe_job.light, light_measure(probe_job.light, p), p, vec3<f32>(0.0), s.wi, y, probe_light_normal(probe_job.light, y)), s.dist, luminance(s.radiance), 0.0);
+                // A convex lamp's pdf is its faces': the face the sample aimed at (any face inside the inner cone).
+                var li = probe_job.light;
+                if (lights[li].kind == LIGHT_CONVEX_LAMP) { li = scene_tri_light(s.prim & PRIM_INDEX_MASK); }
+                o1 = vec4<f32>(light_pdf_li(li, light_measure(li, p), p, vec3<f32>(0.0), s.wi, y, probe_light_normal(li, y)), s.dist, luminance(s.radiance), 0.0);
             }
         }
         case R_BSDF: {
@@ -182,7 +185,8 @@ fn probe_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     probe_out[2u * i + 1u] = o1;
 }
 
-/// in[2i] = (direction, inside flag), in[2i+1] = (light point y, 0); out[i].x = the routine's pdf there. The
+/// in[2i] = (direction, inside flag), in[2i+1] = (light point y, 0 or the light found there + 1); out[i].x = the
+/// routine's pdf there. The
 /// flag carries the support that the pdf function does not see: the cone's rim, whether the ray hits the light.
 @compute @workgroup_size(64)
 fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -197,7 +201,10 @@ fn probe_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         case R_UNIFORM_SPHERE: { pdf = square_to_uniform_sphere_pdf(); }
         case R_CONE: { if (w.w != 0.0) { pdf = square_to_uniform_cone_pdf(probe_job.a.x); } }
         case R_LIGHT: {
-            if (w.w != 0.0) { pdf = light_pdf_li(probe_job.light, light_measure(probe_job.light, probe_job.p.xyz), probe_job.p.xyz, vec3<f32>(0.0), w.xyz, y, probe_light_normal(probe_job.light, y)); }
+            // in[2i+1].w: the light found there where it is not the job's (a convex lamp's face), + 1.
+            let found = u32(probe_in[2u * i + 1u].w);
+            let li = select(probe_job.light, found - 1u, found > 0u);
+            if (w.w != 0.0) { pdf = light_pdf_li(li, light_measure(li, probe_job.p.xyz), probe_job.p.xyz, vec3<f32>(0.0), w.xyz, y, probe_light_normal(li, y)); }
         }
         case R_BSDF: {
             pdf = bsdf_pdf(probe_bsdf(), probe_job.p.xyz, w.xyz);
@@ -345,7 +352,7 @@ impl Setup {
         let h = harness();
         let d = h.data(scene);
         let frame = GpuFrameParams {
-            num_lights: d.lights.len() as u32,
+            num_lights: d.selectable_lights() as u32,
             env_light: d.env_light.unwrap_or(INVALID),
             env_width: d.env_size.0,
             env_height: d.env_size.1,
@@ -414,6 +421,14 @@ fn para_geom() -> [DVec3; 3] {
 
 /// Lights: a triangle, a rectangle, a parallelogram (all L = 1 except the parallelogram), a sphere (L = 1), a
 /// tiny sphere, a bright sphere and a point light (for power-proportional selection).
+/// A convex lamp (src/accel/convex_lamps.rs): a 6 × 12 UV sphere, coarse enough that its rim, outside the inner
+/// sphere's cone, is 13 % of its silhouette.
+const LAMP_C: Vec3 = Vec3::new(6.0, 1.0, 0.0);
+const LAMP_R: f32 = 0.5;
+fn lamp_tris() -> Vec<[Vec3; 3]> {
+    common::uv_sphere(LAMP_C, LAMP_R, 6, 12, true)
+}
+
 fn lights_scene() -> Scene {
     let t = tri_verts();
     let [rc, ru, rv] = rect_geom();
@@ -426,13 +441,22 @@ fn lights_scene() -> Scene {
             Material::emitter("warm", Vec3::new(5.0, 3.0, 1.0)),
             Material::emitter("dim", Vec3::splat(0.2)),
         ],
-        meshes: vec![Mesh {
-            name: "tri".into(),
-            positions: t.iter().map(|&p| v(p)).collect(),
-            indices: vec![[0, 1, 2]],
-            material: 0,
-            ..Default::default()
-        }],
+        meshes: vec![
+            Mesh {
+                name: "tri".into(),
+                positions: t.iter().map(|&p| v(p)).collect(),
+                indices: vec![[0, 1, 2]],
+                material: 0,
+                ..Default::default()
+            },
+            Mesh {
+                name: "lamp".into(),
+                positions: lamp_tris().iter().flatten().copied().collect(),
+                indices: (0..lamp_tris().len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+                material: 1,
+                ..Default::default()
+            },
+        ],
         quads: vec![
             Quad { corner: v(rc), edge_u: v(ru), edge_v: v(rv), material: 0 },
             Quad { corner: v(pc), edge_u: v(pu), edge_v: v(pv), material: 1 },
@@ -1030,9 +1054,69 @@ fn sphere_area_case(name: &str, config: &str, light: u32, geom: LightGeom, p: DV
     case
 }
 
+/// The convex lamp's faces as the device holds them: each face's light index and vertices.
+fn lamp_faces() -> (u32, Vec<(u32, [DVec3; 3])>) {
+    let d = harness().data(SceneId::Lights);
+    let lamp = d.lights.iter().position(|l| l.kind == LIGHT_CONVEX_LAMP).expect("the sampling scene has a lamp");
+    let (first, n) = (d.lights[lamp].prim as usize, d.lights[lamp].area as usize);
+    let faces = (first..first + n)
+        .map(|i| {
+            let t = d.lights[i].prim as usize;
+            (i as u32, std::array::from_fn(|k| d3(&d.tri_verts[3 * t + k])))
+        })
+        .collect();
+    (lamp as u32, faces)
+}
+
+/// The first face a ray from p along w meets, from the front: the point and the face's light.
+fn lamp_hit(faces: &[(u32, [DVec3; 3])], p: DVec3, w: DVec3) -> Option<(DVec3, u32)> {
+    faces
+        .iter()
+        .filter(|(_, v)| (v[1] - v[0]).cross(v[2] - v[0]).dot(w) < 0.0)
+        .filter_map(|(i, v)| hit_triangle(p, w, v).map(|y| (y, *i)))
+        .min_by(|a, b| (a.0 - p).length().total_cmp(&(b.0 - p).length()))
+}
+
+/// A convex lamp seen from p, binned in a cap around the sphere its vertices lie on: the pdf function is asked
+/// at the face each direction meets first.
+fn lamp_case(config: &str, p: DVec3, mode: LightSampling) -> Case {
+    let (lamp, faces) = lamp_faces();
+    let mut s = Setup::new(SceneId::Lights, R_LIGHT);
+    s.job.light = lamp;
+    s.job.p = v4(p, 0.0);
+    s.frame.light_sampling = mode.tag();
+    let dom = Dom::Cap(LightGeom::Sphere(LAMP_C.as_dvec3(), LAMP_R as f64).cap(p));
+    let mut c = Case::new("convex lamp", format!("{config}, {mode}"), s, dom);
+    // Rim draws inside the cone and faces seen from behind are failed samples: the pdf integrates to the rest.
+    c.may_fail = true;
+    c.pdf_input = Box::new(move |w| match lamp_hit(&faces, p, w) {
+        Some((y, face)) => ([v4(w, 1.0), v4(y, (face + 1) as f64)], 1.0),
+        None => ([v4(w, 0.0), [0.0; 4]], 1.0),
+    });
+    c
+}
+
 #[test]
 fn chi2_lights() {
     run_all("lights", &light_cases());
+}
+
+/// A convex lamp's two parts — the inner sphere's cone and the rim drawn by faces — against the density its faces
+/// report, from far and from close by, and by area (every sample a face).
+#[test]
+fn chi2_convex_lamp() {
+    let c = LAMP_C.as_dvec3();
+    let r = LAMP_R as f64;
+    let far = f32v(c + DVec3::new(-1.0, 0.4, 0.6).normalize() * 4.0 * r);
+    let near = f32v(c + DVec3::new(0.3, -1.0, 0.5).normalize() * 1.3 * r);
+    run_all(
+        "convex lamp",
+        &[
+            lamp_case("d = 4r", far, LightSampling::SolidAngle),
+            lamp_case("d = 1.3r", near, LightSampling::SolidAngle),
+            lamp_case("d = 4r", far, LightSampling::Area),
+        ],
+    );
 }
 
 /// Back faces of one-sided emitters: no sample, pdf 0, in both modes.
@@ -1563,7 +1647,7 @@ fn selection_histogram(s: &Setup, n_lights: usize, seed: u32) -> (Vec<u64>, Vec<
 #[test]
 fn chi2_light_selection() {
     let h = harness();
-    let n_lights = h.data(SceneId::Lights).lights.len();
+    let n_lights = h.data(SceneId::Lights).selectable_lights();
     let mut rows = Vec::new();
     for select in [LightSelect::Uniform, LightSelect::Power] {
         let mut s = Setup::new(SceneId::Lights, R_SELECT);
