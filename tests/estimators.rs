@@ -1102,23 +1102,15 @@ fn light_tree_and_ris_agree_on_the_veach_gltf_scene() {
 /// A coarsely tessellated sphere lamp (120 faces: the rim outside its inner sphere is 13 % of its silhouette) over
 /// a grey floor, in front of a grey wall.
 fn lamp_room() -> Scene {
-    let mesh = |name: &str, tris: &[[Vec3; 3]], material: u32| mislab::scene::Mesh {
-        name: name.into(),
-        positions: tris.iter().flatten().copied().collect(),
-        indices: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
-        material,
-        ..Default::default()
-    };
-    let rect = |c: Vec3, u: Vec3, v: Vec3| [[c, c + u, c + u + v], [c, c + u + v, c + v]];
     let floor = rect(Vec3::new(-3.0, 0.0, 2.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0));
     let wall = rect(Vec3::new(-3.0, 0.0, -2.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
     Scene {
         name: "lamp-room".into(),
         materials: vec![Material::emitter("lamp", Vec3::splat(6.0)), Material::lambert("grey", Vec3::splat(0.5))],
         meshes: vec![
-            mesh("lamp", &uv_sphere(Vec3::new(0.3, 0.9, -0.6), 0.35, 6, 12, true), 0),
-            mesh("floor", &floor, 1),
-            mesh("wall", &wall, 1),
+            mesh_of("lamp", &uv_sphere(Vec3::new(0.3, 0.9, -0.6), 0.35, 6, 12, true), 0),
+            mesh_of("floor", &floor, 1),
+            mesh_of("wall", &wall, 1),
         ],
         camera: Camera::look_at(Vec3::new(0.0, 1.6, 4.0), Vec3::new(0.0, 0.7, -0.5), Vec3::Y, 45.0),
         ..Default::default()

@@ -10,9 +10,9 @@ use mislab::render::gpu_scene::GpuScene;
 use mislab::render::scene_data::SceneData;
 use mislab::render::settings::{LightSelect, Mode, Settings, Strategy};
 use mislab::render::Renderer;
-use mislab::scene::{Camera, Material, Mesh, Scene};
+use mislab::scene::{Camera, Material, Scene};
 
-use common::uv_sphere;
+use common::{mesh_of, rect, uv_sphere};
 
 fn one_sided(_: usize) -> Option<bool> {
     Some(false)
@@ -92,14 +92,6 @@ fn meshes_that_could_hide_their_own_points_are_not_isolated() {
 /// device keeps world coordinates): every coordinate the shader rounds is then large against the lamp.
 fn sphere_over_plates(far: bool) -> (Scene, usize) {
     let sphere = uv_sphere(Vec3::new(0.0, 1.5, 0.0), 0.5, 24, 48, true);
-    let mesh = |name: &str, tris: &[[Vec3; 3]], material: u32| Mesh {
-        name: name.into(),
-        positions: tris.iter().flatten().copied().collect(),
-        indices: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
-        material,
-        ..Default::default()
-    };
-    let rect = |c: Vec3, u: Vec3, v: Vec3| [[c, c + u, c + u + v], [c, c + u + v, c + v]];
     let floor = rect(Vec3::new(-3.0, 0.0, 3.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0));
     // 4e-3 below the sphere's lowest point (its stop box is padded by 5e-4 and keeps a 1e-3 margin clear).
     let under = rect(Vec3::new(-0.3, 0.996, 0.3), Vec3::new(0.6, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.6));
@@ -109,10 +101,10 @@ fn sphere_over_plates(far: bool) -> (Scene, usize) {
         name: "sphere-over-plates".into(),
         materials: vec![Material::emitter("lamp", Vec3::splat(4.0)), Material::lambert("grey", Vec3::splat(0.5))],
         meshes: vec![
-            mesh("lamp", &sphere, 0),
-            mesh("floor", &floor, 1),
-            mesh("under", &under, 1),
-            mesh("beside", &beside, 1),
+            mesh_of("lamp", &sphere, 0),
+            mesh_of("floor", &floor, 1),
+            mesh_of("under", &under, 1),
+            mesh_of("beside", &beside, 1),
         ],
         camera: Camera {
             position: Vec3::new(2.5, 3.5, 3.5),

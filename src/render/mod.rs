@@ -10,6 +10,7 @@ pub mod error;
 pub mod features;
 pub mod film;
 pub mod gpu_scene;
+pub mod light_table;
 pub mod lights;
 pub mod pipeline_cache;
 pub mod progressive;

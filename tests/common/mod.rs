@@ -112,3 +112,19 @@ pub fn uv_sphere(c: Vec3, r: f32, rings: u32, segs: u32, outward: bool) -> Vec<[
     }
     tris
 }
+
+/// A mesh of separate triangles (no shared vertices) of material `material`.
+pub fn mesh_of(name: &str, tris: &[[Vec3; 3]], material: u32) -> mislab::scene::Mesh {
+    mislab::scene::Mesh {
+        name: name.into(),
+        positions: tris.iter().flatten().copied().collect(),
+        indices: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+        material,
+        ..Default::default()
+    }
+}
+
+/// The parallelogram c, c + u, c + u + v, c + v as two triangles (wound from u towards v).
+pub fn rect(c: Vec3, u: Vec3, v: Vec3) -> [[Vec3; 3]; 2] {
+    [[c, c + u, c + u + v], [c, c + u + v, c + v]]
+}
