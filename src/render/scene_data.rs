@@ -284,7 +284,6 @@ impl SceneData {
         }
     }
 
-    /// Material index of triangle `i`.
     /// How many convex lamps (`accel::convex_lamps`) the light table holds.
     pub fn convex_lamps(&self) -> usize {
         self.lights.iter().filter(|l| l.kind == LIGHT_CONVEX_LAMP).count()
@@ -295,6 +294,7 @@ impl SceneData {
         self.lights.len() - self.lamp_faces
     }
 
+    /// Material index of triangle `i`.
     pub fn tri_material(&self, i: usize) -> u32 {
         word_material(self.shading_verts[self.tri_shading[i].corners[0] as usize].material)
     }
