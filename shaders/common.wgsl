@@ -281,9 +281,9 @@ struct FrameParams {
     guide_on: u32,
     /// One 8×8 tile in this many learns the guide (1, 2 or 4; env_guide_learner_tile).
     guide_learner_period: u32,
-    _pad_guide0: u32,
-    _pad_guide1: u32,
-    _pad_guide2: u32,
+    lamp_first: u32,       // the convex lamps: lamp_count entries of the light table from lamp_first
+    lamp_count: u32,
+    lamps_only: u32,       // 1: they are the scene's only emitters
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;

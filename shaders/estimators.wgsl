@@ -129,6 +129,17 @@ fn stop_box_entry(prim: u32, o: vec3<f32>, d: vec3<f32>) -> f32 {
     return entry * (1.0 + 1e-5);
 }
 
+/// Whether the ray from o along d (t > 0) meets the box lo..hi or starts in it; rounding errs towards yes.
+fn ray_meets_box(lo: vec3<f32>, hi: vec3<f32>, o: vec3<f32>, d: vec3<f32>) -> bool {
+    let sgn = select(vec3<f32>(1.0), vec3<f32>(-1.0), d < vec3<f32>(0.0));
+    let inv = 1.0 / select(d, sgn * 1e-30, abs(d) < vec3<f32>(1e-30));
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
+    let near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
+    let far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    return far * (1.0 + 1e-5) >= max(near, 0.0) * (1.0 - 1e-5);
+}
+
 /// Whether nothing blocks the segment from x to the light sample's point (or direction, for distant lights).
 fn unoccluded(x: Surface, ls: LightSample) -> bool {
     let o = spawn_origin(x, ls.wi);
@@ -408,6 +419,8 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
             let w = to_world(c.frame, ds.wi);
             if (wrong_side(c, w, ds.wi)) { continue; }
             let o = spawn_origin(c.x, w);
+            // Where the only emitters are a few convex lamps, a direction that meets none of them finds nothing.
+            if (finds_no_emission(o, w)) { continue; }
             rays_traced += 1u;
             let found = found_emission(o, w, trace_closest(o, w, F32_MAX));
             if (all(found.le == vec3<f32>(0.0))) { continue; }

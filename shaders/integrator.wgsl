@@ -58,6 +58,9 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
 /// the ray leaving the last one is traced only for the emission it finds.
 fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     let ray = *r;
+    // A ray traced only for the emission it finds (a path's last, every direction sample in direct mode) finds none
+    // where the scene's only emitters are a few convex lamps and it meets none of their stop boxes: not traced.
+    if (ray.bounce > 0u && ray.bounce >= depth && finds_no_emission(ray.o, ray.d)) { return false; }
     rays_traced += 1u;
     let hit = trace_closest(ray.o, ray.d, F32_MAX);
     let found = found_emission(ray.o, ray.d, hit);

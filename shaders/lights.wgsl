@@ -522,6 +522,21 @@ fn lamp_face_pdf_li(face: Light, m: LightMeasure, p: vec3<f32>, wi: vec3<f32>, y
     return by_area / l.area * triangle_pdf_li(face, LightMeasure(MEASURE_AREA, 0.0), p, wi, y, n_y);
 }
 
+/// Whether a ray from o along d certainly finds no emission without being traced: the scene's only emitters are a
+/// few convex lamps (`params.lamps_only`) and the ray enters none of their stop boxes (nor starts in one).
+const MAX_LAMPS_TESTED: u32 = 8u;
+fn finds_no_emission(o: vec3<f32>, d: vec3<f32>) -> bool {
+    if (!HAS_CONVEX_LAMPS || params.lamps_only == 0u || params.lamp_count > MAX_LAMPS_TESTED) { return false; }
+    return !ray_may_meet_a_lamp(o, d);
+}
+fn ray_may_meet_a_lamp(o: vec3<f32>, d: vec3<f32>) -> bool {
+    for (var k = 0u; k < params.lamp_count; k += 1u) {
+        let l = scene_light(params.lamp_first + k);
+        if (ray_meets_box(l.position, l.direction, o, d)) { return true; }
+    }
+    return false;
+}
+
 /// The light a light found by a ray counts as when chosen: a lamp's face (the entries from num_lights on) its lamp.
 fn chosen_light(i: u32) -> u32 {
     if (!HAS_CONVEX_LAMPS || i == INVALID || i < params.num_lights) { return i; }

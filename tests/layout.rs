@@ -144,9 +144,9 @@ fn shared_structs_match() {
             guide_dims,
             guide_on,
             guide_learner_period,
-            _pad_guide0,
-            _pad_guide1,
-            _pad_guide2
+            lamp_first,
+            lamp_count,
+            lamps_only
         ]
     );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);

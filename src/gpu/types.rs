@@ -248,9 +248,12 @@ pub struct GpuFrameParams {
     pub guide_on: u32,
     /// One 8×8 tile in this many learns the guide (1, 2 or 4; `env_guide::learner_period`).
     pub guide_learner_period: u32,
-    pub _pad_guide0: u32,
-    pub _pad_guide1: u32,
-    pub _pad_guide2: u32,
+    /// The convex lamps' entries in the light table: `lamp_count` of them from `lamp_first` (they follow each
+    /// other; `accel::convex_lamps`).
+    pub lamp_first: u32,
+    pub lamp_count: u32,
+    /// 1: the lamps are the scene's only emitters (no other light, no environment).
+    pub lamps_only: u32,
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

@@ -78,6 +78,8 @@ pub struct Renderer {
     env_scale: f32,
     env_rotation: f32,
     num_lights: u32,
+    /// The convex lamps' entries in the light table (first, count) and whether they are its only lights.
+    lamps: (u32, u32, bool),
     /// The scene's render origin (`SceneData::origin`): the camera is placed relative to it.
     origin: glam::Vec3,
     offset_scale: f32,
@@ -236,6 +238,7 @@ impl Renderer {
             env_scale: d.env_scale,
             env_rotation: d.env_rotation,
             num_lights: d.selectable_lights() as u32,
+            lamps: d.lamp_range(),
             origin: d.origin,
             offset_scale: d.offset_scale,
             source: render_source_for(d),
@@ -515,9 +518,9 @@ impl Renderer {
             guide_dims: self.guide_grid.dims.into(),
             guide_on: self.guide_on as u32,
             guide_learner_period: self.guide_learner_period(),
-            _pad_guide0: 0,
-            _pad_guide1: 0,
-            _pad_guide2: 0,
+            lamp_first: self.lamps.0,
+            lamp_count: self.lamps.1,
+            lamps_only: self.lamps.2 as u32,
         }
     }
 

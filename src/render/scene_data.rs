@@ -289,6 +289,14 @@ impl SceneData {
         self.lights.iter().filter(|l| l.kind == LIGHT_CONVEX_LAMP).count()
     }
 
+    /// The convex lamps' entries in the light table, (first, count, whether they are the only lights): they follow
+    /// each other. (0, 0, false) for none.
+    pub fn lamp_range(&self) -> (u32, u32, bool) {
+        let n = self.convex_lamps();
+        let first = self.lights.iter().position(|l| l.kind == LIGHT_CONVEX_LAMP);
+        first.map_or((0, 0, false), |f| (f as u32, n as u32, n == self.selectable_lights()))
+    }
+
     /// The lights that selection chooses among: the first this many of `lights`.
     pub fn selectable_lights(&self) -> usize {
         self.lights.len() - self.lamp_faces
