@@ -111,16 +111,8 @@ fn stop_box_entry(prim: u32, o: vec3<f32>, d: vec3<f32>) -> f32 {
     if li == INVALID || lights[li].shadow_box == 0u {
         return F32_MAX;
     }
-    let lo = lights[li].position;
-    let hi = lights[li].direction;
-    // A direction component near 0 takes a tiny stand-in of its sign: that slab's planes then lie at ±huge t,
-    // as they should (never NaN from 0 · ∞).
-    let sgn = select(vec3<f32>(1.0), vec3<f32>(-1.0), d < vec3<f32>(0.0));
-    let inv = 1.0 / select(d, sgn * 1e-30, abs(d) < vec3<f32>(1e-30));
-    let t0 = (lo - o) * inv;
-    let t1 = (hi - o) * inv;
-    let near = min(t0, t1);
-    let entry = max(max(near.x, near.y), near.z);
+    let s = box_slabs(lights[li].position, lights[li].direction, o, d);
+    let entry = max(max(s.near.x, s.near.y), s.near.z);
     if !(entry > 0.0) {
         return F32_MAX;
     }
@@ -129,14 +121,26 @@ fn stop_box_entry(prim: u32, o: vec3<f32>, d: vec3<f32>) -> f32 {
     return entry * (1.0 + 1e-5);
 }
 
-/// Whether the ray from o along d (t > 0) meets the box lo..hi or starts in it; rounding errs towards yes.
-fn ray_meets_box(lo: vec3<f32>, hi: vec3<f32>, o: vec3<f32>, d: vec3<f32>) -> bool {
+/// The t at which the ray from o along d crosses the box lo..hi's near and far plane of each axis.
+struct BoxSlabs {
+    near: vec3<f32>,
+    far: vec3<f32>,
+}
+fn box_slabs(lo: vec3<f32>, hi: vec3<f32>, o: vec3<f32>, d: vec3<f32>) -> BoxSlabs {
+    // A direction component near 0 takes a tiny stand-in of its sign: that slab's planes then lie at ±huge t,
+    // as they should (never NaN from 0 · ∞).
     let sgn = select(vec3<f32>(1.0), vec3<f32>(-1.0), d < vec3<f32>(0.0));
     let inv = 1.0 / select(d, sgn * 1e-30, abs(d) < vec3<f32>(1e-30));
     let t0 = (lo - o) * inv;
     let t1 = (hi - o) * inv;
-    let near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
-    let far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    return BoxSlabs(min(t0, t1), max(t0, t1));
+}
+
+/// Whether the ray from o along d (t > 0) meets the box lo..hi or starts in it; rounding errs towards yes.
+fn ray_meets_box(lo: vec3<f32>, hi: vec3<f32>, o: vec3<f32>, d: vec3<f32>) -> bool {
+    let s = box_slabs(lo, hi, o, d);
+    let near = max(max(s.near.x, s.near.y), s.near.z);
+    let far = min(min(s.far.x, s.far.y), s.far.z);
     return far * (1.0 + 1e-5) >= max(near, 0.0) * (1.0 - 1e-5);
 }
 
