@@ -357,8 +357,22 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
         }
         return baked_traverse(r, hit, skip);
     }
+    if BAKED_OCCLUDERS {
+        // A few large occluders first: their hit shortens the BVH walk, and a shadow ray they block ends here.
+        if any_hit {
+            if baked_occluded(r, t_max, skip) {
+                return Hit(t_max, 0u, 0.0, 0.0);
+            }
+        } else {
+            hit = baked_traverse(r, hit, skip);
+        }
+    }
     if WIDE_BVH {
-        return wide_traverse(r, t_max, any_hit, skip);
+        let h = wide_traverse(r, hit.t, any_hit, skip);
+        if h.prim != INVALID {
+            hit = h;
+        }
+        return hit;
     }
     // This invocation's slice of the workgroup stacks.
     let base = bvh_lane * BVH_STACK_SIZE;

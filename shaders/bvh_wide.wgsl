@@ -97,6 +97,14 @@ fn wide_traverse(r: TraceRay, t_max: f32, any_hit: bool, skip: u32) -> Hit {
     let finite_ray = all(abs(r.o) <= vec3<f32>(F32_MAX)) && all(abs(r.inv_d) <= vec3<f32>(F32_MAX));
     var g = vec2<u32>(0u, select(0u, 1u << (24u + oct), finite_ray));
     var tg = vec2<u32>(0u, 0u);
+    if BAKED_ROOT {
+        // The root's boxes are literals in a scene's own pipeline (baked_geometry.wgsl): a SIMD group whose rays
+        // all stop at a baked occluder before the BVH's boxes, or miss them, never enters the loop below.
+        let root = baked_wide_root();
+        let hits = select(0u, baked_root_hits(r, oct, t_max), finite_ray);
+        g = vec2<u32>(root.links.x, (hits & WIDE_NODE_BITS) | (root.head.w >> 24u));
+        tg = vec2<u32>(root.links.y, hits & ~WIDE_NODE_BITS);
+    }
     var sp = 0u;
     // The stack's top entry is held in registers (`top`, when `top_full`) and only the ones below it in workgroup
     // memory: lavapipe runs each workgroup-memory access as a loop over the SIMD lanes, and most pushed groups are

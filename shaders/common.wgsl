@@ -284,6 +284,9 @@ struct FrameParams {
     lamp_first: u32,       // the convex lamps: lamp_count entries of the light table from lamp_first
     lamp_count: u32,
     lamps_only: u32,       // 1: they are the scene's only emitters
+    occluder_first: u32,   // the triangles outside the BVH (src/render/scene_data.rs occluder_split)
+    occluder_count: u32,
+    _pad_occluders: vec2<u32>,
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;
@@ -348,3 +351,13 @@ override HAS_DIFFUSE: bool = true;
 override MANY_LIGHTS: bool = true;
 /// Scenes of a few primitives, baked into the shader: traversal is the generated `baked_traverse` (src/render/baked.rs).
 override FLAT_SCENE: bool = false;
+/// A few occluder triangles outside the BVH, tested before it (`baked_traverse`, `baked_occluded`): as literals in
+/// a scene's own pipeline, in a loop over `occluder_range()` in the generic one (src/render/scene_data.rs
+/// `occluder_split`).
+override BAKED_OCCLUDERS: bool = false;
+/// The wide BVH's root tested as literals before the traversal loop (bvh_wide.wgsl): in a scene's own pipeline with
+/// baked occluders, not in the generic one (which would only read the root node outside the loop instead of in it).
+override BAKED_ROOT: bool = false;
+/// Rays traced only for their emission stop at a convex lamp's box where they meet its inner sphere
+/// (lights.wgsl `lamp_in_sight`): in a scene's own pipeline.
+override LAMP_SIGHTING: bool = false;

@@ -40,3 +40,5 @@ fn scene_sphere(i: u32) -> Sphere { return spheres[i]; }
 fn scene_quad(i: u32) -> Quad { return quads[i]; }
 fn scene_material(i: u32) -> Material { return materials[i]; }
 fn scene_light(i: u32) -> Light { return lights[i]; }
+/// The triangles outside the BVH as (first slot, count): what the generic pipeline's `baked_traverse` loops over.
+fn occluder_range() -> vec2<u32> { return vec2<u32>(params.occluder_first, params.occluder_count); }

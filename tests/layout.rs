@@ -146,7 +146,10 @@ fn shared_structs_match() {
             guide_learner_period,
             lamp_first,
             lamp_count,
-            lamps_only
+            lamps_only,
+            occluder_first,
+            occluder_count,
+            _pad_occluders
         ]
     );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);

@@ -254,6 +254,11 @@ pub struct GpuFrameParams {
     pub lamp_count: u32,
     /// 1: the lamps are the scene's only emitters (no other light, no environment).
     pub lamps_only: u32,
+    /// The triangles outside the BVH (`SceneData::occluders`): `occluder_count` slots from `occluder_first`, which
+    /// the generic pipeline tests in a loop (a scene's own pipeline has them as literals).
+    pub occluder_first: u32,
+    pub occluder_count: u32,
+    pub _pad_occluders: [u32; 2],
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

@@ -191,20 +191,213 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "quads[i]");
     out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
     out += &accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights, "lights[i]");
-    Some((out, baked_traverse_source(data)))
+    // (No BVH is walked, but the wide traversal that is compiled out still names the root functions.)
+    Some((out, baked_traverse_source(data, 0..data.tri_shading.len(), true) + BUFFER_ROOT))
 }
 
-/// `baked_traverse` (closest hit) and `baked_occluded` (shadow rays) for `data`: every primitive's test with its
-/// data as literals.
-fn baked_traverse_source(data: &SceneData) -> String {
+/// `fn name(i: u32) -> ty` returning entry i of `items` through a chain of selections for i < items.len(), and
+/// reading `buffer_read` beyond (where a table's first entries are few and read often: a scene's lamps before
+/// their faces). The whole function reads the buffer when an entry cannot be written as literals.
+fn accessor_prefix<T: bytemuck::Pod>(
+    name: &str,
+    ty: &str,
+    members: &[String],
+    items: &[T],
+    buffer_read: &str,
+) -> String {
+    let lits: Option<Vec<String>> =
+        items.iter().map(|x| struct_lit(ty, members, bytemuck::cast_slice(std::slice::from_ref(x)))).collect();
+    match lits {
+        Some(l) if !l.is_empty() => {
+            let mut f = format!(
+                "fn {name}(i: u32) -> {ty} {{\n    if i >= {}u {{ return {buffer_read}; }}\n    var x = {};\n",
+                l.len(),
+                l[0]
+            );
+            for (k, e) in l.iter().enumerate().skip(1) {
+                let _ = writeln!(f, "    if (i == {k}u) {{ x = {e}; }}");
+            }
+            f + "    return x;\n}\n"
+        }
+        _ => format!("fn {name}(i: u32) -> {ty} {{ return {buffer_read}; }}\n"),
+    }
+}
+
+/// Most materials, and most lights that selection chooses among, a scene with baked occluders has as literals.
+const LITERAL_TABLE_MAX: usize = 32;
+
+/// The generated `scene_data.wgsl` of a scene with baked occluders: the buffer-reading one with the materials and
+/// the lights that selection chooses among (its few lamps, not their faces) as literals when they are few.
+pub fn occluder_scene_data_source(data: &SceneData) -> Option<String> {
+    occluder_source(data)?;
+    let mut out = crate::render::shaders::file("scene_data.wgsl").to_string();
+    if data.materials.len() <= LITERAL_TABLE_MAX {
+        let f = accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
+        out = out.replace("fn scene_material(i: u32) -> Material { return materials[i]; }\n", &f);
+    }
+    let n = data.selectable_lights();
+    if n <= LITERAL_TABLE_MAX {
+        let f = accessor_prefix("scene_light", "Light", &wgsl_members("Light"), &data.lights[..n], "lights[i]");
+        out = out.replace("fn scene_light(i: u32) -> Light { return lights[i]; }\n", &f);
+    }
+    // The occluders' positions, corners (record indices, as the buffer's w words hold them) and shading records:
+    // what shading a hit on one reads.
+    let (first, count) = (data.occluders.0 as usize, data.occluders.1 as usize);
+    let words = |i: usize, k: usize| data.tri_verts[3 * i + k].map(f32::to_bits);
+    let positions: Vec<[u32; 12]> = (first..first + count)
+        .map(|i| {
+            let (a, b, c) = (words(i, 0), words(i, 1), words(i, 2));
+            [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], a[3], b[3], c[3]]
+        })
+        .collect();
+    let members = ["vec3<f32>", "vec3<f32>", "vec3<f32>", "vec3<u32>"].map(String::from);
+    out += &accessor("occluder_tri_positions", "TriPositions", &members, &positions, "TriPositions()");
+    let (f, c) = (first, count);
+    let inject = |out: String, head: &str, body: &str| {
+        assert!(out.contains(head), "scene_data.wgsl has `{head}`");
+        out.replace(head, &format!("{head}\n    if i - {f}u < {c}u {{ {body} }}"))
+    };
+    out = inject(
+        out,
+        "fn scene_tri_positions(i: u32) -> TriPositions {",
+        &format!("return occluder_tri_positions(i - {f}u);"),
+    );
+    out = inject(
+        out,
+        "fn scene_tri_corner(i: u32, k: u32) -> u32 {",
+        &format!("return occluder_tri_positions(i - {f}u).corners[k];"),
+    );
+    out = inject(out, "fn scene_tri_light(i: u32) -> u32 {", "return INVALID;");
+    if data.shading_record_stride() == 1 {
+        let mut records: Vec<u32> = positions.iter().flat_map(|p| [p[9], p[10], p[11]]).collect();
+        records.sort_unstable();
+        records.dedup();
+        let mut body = String::from("var hit = false;\n    var x = ShadingVertex(0u, 0u, vec2<f32>(0.0));\n");
+        for r in records {
+            let [n, m] = data.shading_records[r as usize];
+            let _ =
+                writeln!(body, "    if (r == {r}u) {{ x = ShadingVertex({n}u, {m}u, vec2<f32>(0.0)); hit = true; }}");
+        }
+        body += "    if hit { return x; }";
+        let head = "fn scene_shading_vertex(r: u32) -> ShadingVertex {";
+        assert!(out.contains(head));
+        out = out.replace(head, &format!("{head}\n    {body}"));
+    }
+    Some(out)
+}
+
+/// The root functions of baked_geometry.wgsl as they read the wide BVH's root node from its buffer.
+const BUFFER_ROOT: &str = "
+fn baked_wide_root() -> WideNode {
+    return wide_node(0u);
+}
+
+fn baked_root_hits(r: TraceRay, oct: u32, t: f32) -> u32 {
+    return wide_node_hits(r, oct, wide_node(0u), t);
+}
+";
+
+/// `baked_wide_root` (the root node's links as literals) and `baked_root_hits`: the root's children tested
+/// against their exact f32 boxes, as literals. Exact, not the node's 8-bit boxes: those are rounded outwards by up
+/// to 1/255 of the root's extent, far more than a small lamp's size, so a shadow ray stopping at a lamp's box would
+/// still enter the lamp's subtree.
+fn baked_root_source(data: &SceneData, root: &crate::accel::wide_bvh::GpuWideNode) -> String {
+    use crate::accel::wide_bvh::{WideChild, WIDTH};
+    let w: &[u32] = bytemuck::cast_slice(std::slice::from_ref(root));
+    let v = |k: usize| format!("vec4<u32>({}u, {}u, {}u, {}u)", w[4 * k], w[4 * k + 1], w[4 * k + 2], w[4 * k + 3]);
+    let mut out = format!(
+        "\nfn baked_wide_root() -> WideNode {{\n    return WideNode({}, {}, {}, {}, {});\n}}\n",
+        v(0),
+        v(1),
+        v(2),
+        v(3),
+        v(4)
+    );
+    // The triangles' box of leaf-order entries first..first + count (the BVH is triangle-only: entry j is triangle j).
+    let leaf_box = |first: u32, count: u32, b: &mut (Vec3, Vec3)| {
+        for j in first..first + count {
+            for k in 0..3 {
+                let p = data.tri_verts[3 * j as usize + k];
+                let p = Vec3::new(p[0], p[1], p[2]);
+                b.0 = b.0.min(p);
+                b.1 = b.1.max(p);
+            }
+        }
+    };
+    out += "\nfn baked_root_hits(r: TraceRay, oct: u32, t: f32) -> u32 {\n    var hits = 0u;\n";
+    for slot in 0..WIDTH {
+        let mut b = (Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX));
+        let bits = match root.child(slot) {
+            WideChild::Empty => continue,
+            WideChild::Leaf { first, count } => {
+                leaf_box(first, count, &mut b);
+                ((1u32 << count) - 1) << (root.meta(slot) & 31)
+            }
+            WideChild::Interior(node) => {
+                let mut todo = vec![node];
+                while let Some(n) = todo.pop() {
+                    let n = &data.wide_nodes[n as usize];
+                    for s in 0..WIDTH {
+                        match n.child(s) {
+                            WideChild::Empty => {}
+                            WideChild::Leaf { first, count } => leaf_box(first, count, &mut b),
+                            WideChild::Interior(c) => todo.push(c),
+                        }
+                    }
+                }
+                // The visiting rank's bit: slot ^ oct, computed in the shader.
+                0
+            }
+        };
+        let hit_bits = if bits == 0 { format!("1u << (24u + ({slot}u ^ oct))") } else { format!("{bits}u") };
+        let _ = writeln!(
+            out,
+            "    hits |= select(0u, {hit_bits}, ray_box_entry(r, {}, {}, t) != F32_MAX);",
+            vec3_lit(b.0),
+            vec3_lit(b.1)
+        );
+    }
+    out + "    return hits;\n}\n"
+}
+
+/// The generated `light_tree_loads.wgsl` of a scene with baked occluders and a light tree of at most
+/// `LITERAL_TABLE_MAX` nodes (its few lamps): every node a literal. None otherwise.
+pub fn occluder_light_tree_source(data: &SceneData) -> Option<String> {
+    occluder_source(data)?;
+    let n = data.light_tree.len();
+    if n == 0 || n > LITERAL_TABLE_MAX {
+        return None;
+    }
+    let members = ["vec4<u32>"; 4].map(String::from);
+    Some(accessor("light_node", "LightNode", &members, &data.light_tree, "light_tree[i]"))
+}
+
+/// The generated `baked_geometry.wgsl` of a scene with baked occluders (`SceneData::occluders`): the tests of
+/// those triangles alone, run before the BVH; None when the scene has none (or is baked whole).
+pub fn occluder_source(data: &SceneData) -> Option<String> {
+    let (first, count) = (data.occluders.0 as usize, data.occluders.1 as usize);
+    if count == 0 || flat_counts(data).is_some() {
+        return None;
+    }
+    let mut out = baked_traverse_source(data, first..first + count, false);
+    out += &match data.wide_nodes.first() {
+        Some(root) => baked_root_source(data, root),
+        None => BUFFER_ROOT.into(),
+    };
+    Some(out)
+}
+
+/// `baked_traverse` (closest hit) and `baked_occluded` (shadow rays) for `data`'s triangles `tris` (slots of the
+/// per-triangle arrays) and, with `analytic`, every sphere and quad: each primitive's test with its data as literals.
+fn baked_traverse_source(data: &SceneData, tris: std::ops::Range<usize>, analytic: bool) -> String {
     let mut out = String::from(
         "// baked_geometry.wgsl, generated for one scene by src/render/baked.rs: every intersection test, unrolled.\n\n\
          fn baked_traverse(r: TraceRay, start: Hit, skip: u32) -> Hit {\n    var hit = start;\n",
     );
-    primitive_tests(data, &mut out, Query::Closest);
+    primitive_tests(data, &mut out, Query::Closest, tris.clone(), analytic);
     out += "    return hit;\n}\n\n\
             fn baked_occluded(r: TraceRay, t_max: f32, skip: u32) -> bool {\n    var occluded = false;\n";
-    primitive_tests(data, &mut out, Query::Occluded);
+    primitive_tests(data, &mut out, Query::Occluded, tris, analytic);
     out += "    return occluded;\n}\n";
     out
 }
@@ -218,16 +411,17 @@ enum Query {
     Occluded,
 }
 
-/// Appends every primitive's test for `query`.
-fn primitive_tests(data: &SceneData, out: &mut String, query: Query) {
-    let mesh = MeshTopology::of(&data.tri_verts, data.tri_shading.len());
+/// Appends the tests for `query` of triangles `tris` and, with `analytic`, of every sphere and quad.
+fn primitive_tests(data: &SceneData, out: &mut String, query: Query, tris: std::ops::Range<usize>, analytic: bool) {
+    let first = tris.start;
+    let mesh = MeshTopology::of(&data.tri_verts[3 * first..], tris.len());
     // Each vertex and edge is emitted just before the first triangle that needs it, so fewer values are live
     // at once (spilling them costs more than recomputing would).
     let (mut have_v, mut have_e) = (vec![false; mesh.vertices.len()], vec![false; mesh.edges.len()]);
     // Shadow rays test closed convex meshes (not lights) as solids: a few plane clips instead of their triangles.
     let solids = match query {
         Query::Occluded => {
-            convex_solids(&data.tri_verts, data.tri_shading.len(), |t| data.tri_shading[t].light != INVALID)
+            convex_solids(&data.tri_verts[3 * first..], tris.len(), |t| data.tri_shading[first + t].light != INVALID)
         }
         Query::Closest => vec![],
     };
@@ -251,7 +445,7 @@ fn primitive_tests(data: &SceneData, out: &mut String, query: Query) {
         }
         let (u, v, w) = (mesh.edge_expr(*c, *b), mesh.edge_expr(*a, *c), mesh.edge_expr(*b, *a));
         let call = format!("tri_hit({u}, {v}, {w}, v{a}.z, v{b}.z, v{c}.z, T_MAX)");
-        test_prim(out, query, make_prim(PRIM_TRIANGLE, i as u32), &call);
+        test_prim(out, query, make_prim(PRIM_TRIANGLE, (first + i) as u32), &call);
     }
     for s in &solids {
         out.push_str("    {\n        var span = vec2<f32>(0.0, t_max);\n");
@@ -265,6 +459,9 @@ fn primitive_tests(data: &SceneData, out: &mut String, query: Query) {
         }
         let _ =
             writeln!(out, "        occluded = occluded | (span.x < span.y); // triangles {:?}\n    }}", s.triangles);
+    }
+    if !analytic {
+        return;
     }
     for (i, s) in data.spheres.iter().enumerate() {
         let call = format!("intersect_sphere(r.o, r.d, {}, {}, T_MAX)", vec3_lit(s.center.into()), lit(s.radius));

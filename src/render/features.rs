@@ -5,6 +5,9 @@ use crate::gpu::types::*;
 use crate::render::scene_data::SceneData;
 use crate::render::settings::Settings;
 
+/// `Features::occluders` of the generic pipeline: whatever `FrameParams::occluder_count` says at run time.
+pub const GENERIC_OCCLUDERS: u32 = u32::MAX;
+
 /// What kind of environment the scene has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum EnvKind {
@@ -70,6 +73,9 @@ pub struct Features {
     /// (src/render/baked.rs): every primitive tested, unrolled, with its data as literals, instead of a BVH walk (no
     /// stack, no divergent traversal, no buffer reads). None = BVH.
     pub flat: Option<(u32, u32, u32)>,
+    /// Triangles tested as literals before the BVH, which holds the rest (`SceneData::occluders`); 0 = none;
+    /// `GENERIC_OCCLUDERS`: read from the frame parameters and tested in a loop (the generic pipeline).
+    pub occluders: u32,
     /// For flat scenes, a hash of the scene data baked into its pipelines' source (src/render/baked.rs), so that a
     /// pipeline cache never hands one scene's baked pipeline to another; 0 otherwise.
     pub baked: u64,
@@ -103,6 +109,8 @@ impl Features {
             wide_bvh: crate::render::scene_data::bvh_layout_wide(),
             alpha: true,
             flat: None,
+            // The generic pipeline tests a scene's occluders in a loop over their buffer slots (baked_geometry.wgsl).
+            occluders: GENERIC_OCCLUDERS,
             baked: 0,
         }
     }
@@ -144,7 +152,8 @@ impl Features {
             alpha,
             // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
             flat: crate::render::baked::flat_counts(data).filter(|_| !alpha),
-            baked: crate::render::baked::scene_data_source(data).map_or(0, |src| {
+            occluders: crate::render::baked::occluder_source(data).map_or(0, |_| data.occluders.1),
+            baked: crate::render::render_module::baked_sources(data).map_or(0, |src| {
                 use std::hash::{Hash, Hasher};
                 let mut h = std::collections::hash_map::DefaultHasher::new();
                 src.hash(&mut h);
@@ -180,6 +189,10 @@ impl Features {
             ("HAS_ALPHA", b(self.alpha)),
             ("FLAT_SCENE", b(self.flat.is_some())),
             ("WIDE_BVH", b(self.wide_bvh)),
+            ("BAKED_OCCLUDERS", b(self.occluders > 0)),
+            ("BAKED_ROOT", b(self.occluders > 0 && self.occluders != GENERIC_OCCLUDERS)),
+            // Not in the generic pipeline: its compilation is minutes already, and this changes no pixel.
+            ("LAMP_SIGHTING", b(self.convex_lamps && self.occluders != GENERIC_OCCLUDERS)),
         ]
     }
 
@@ -214,6 +227,9 @@ impl Features {
         on("8-wide compressed BVH", self.wide_bvh && self.flat.is_none());
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));
+        }
+        if self.occluders > 0 && self.occluders != GENERIC_OCCLUDERS {
+            v.push(format!("{} occluder triangles baked into the shader, the emitters in the BVH", self.occluders));
         }
         v.push(format!("environment: {:?}", self.env).to_lowercase());
         v.join(", ")

@@ -38,12 +38,28 @@ pub fn render_source() -> String {
     shaders::compose(RENDER_FILES, "")
 }
 
-/// The render module for one scene: with its data baked in when it is small enough (`Features::flat`), else
-/// `render_source()`.
+/// The generated replacements of the render module's files for one scene, or None when it reads everything from
+/// buffers: its data and every intersection test when it is small enough (`Features::flat`), or the tests of its
+/// few occluders, run before the BVH (`SceneData::occluders`).
+pub fn baked_sources(data: &crate::render::scene_data::SceneData) -> Option<Vec<(&'static str, String)>> {
+    if let Some((data, geometry)) = crate::render::baked::scene_data_source(data) {
+        return Some(vec![("scene_data.wgsl", data), ("baked_geometry.wgsl", geometry)]);
+    }
+    let geometry = crate::render::baked::occluder_source(data)?;
+    let tables = crate::render::baked::occluder_scene_data_source(data)?;
+    let mut files = vec![("scene_data.wgsl", tables), ("baked_geometry.wgsl", geometry)];
+    if let Some(tree) = crate::render::baked::occluder_light_tree_source(data) {
+        files.push(("light_tree_loads.wgsl", tree));
+    }
+    Some(files)
+}
+
+/// The render module for one scene: with what `baked_sources` generates for it, else `render_source()`.
 pub fn render_source_for(data: &crate::render::scene_data::SceneData) -> String {
-    match crate::render::baked::scene_data_source(data) {
-        Some((data, geometry)) => {
-            shaders::compose_replacing(RENDER_FILES, &[("scene_data.wgsl", &data), ("baked_geometry.wgsl", &geometry)])
+    match baked_sources(data) {
+        Some(files) => {
+            let files: Vec<(&str, &str)> = files.iter().map(|(n, s)| (*n, s.as_str())).collect();
+            shaders::compose_replacing(RENDER_FILES, &files)
         }
         None => render_source(),
     }

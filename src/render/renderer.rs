@@ -80,6 +80,8 @@ pub struct Renderer {
     num_lights: u32,
     /// The convex lamps' entries in the light table (first, count) and whether they are its only lights.
     lamps: (u32, u32, bool),
+    /// `SceneData::occluders`, for the frame parameters.
+    occluders: (u32, u32),
     /// The scene's render origin (`SceneData::origin`): the camera is placed relative to it.
     origin: glam::Vec3,
     offset_scale: f32,
@@ -239,6 +241,7 @@ impl Renderer {
             env_rotation: d.env_rotation,
             num_lights: d.selectable_lights() as u32,
             lamps: d.lamp_range(),
+            occluders: d.occluders,
             origin: d.origin,
             offset_scale: d.offset_scale,
             source: render_source_for(d),
@@ -521,6 +524,9 @@ impl Renderer {
             lamp_first: self.lamps.0,
             lamp_count: self.lamps.1,
             lamps_only: self.lamps.2 as u32,
+            occluder_first: self.occluders.0,
+            occluder_count: self.occluders.1,
+            _pad_occluders: [0; 2],
         }
     }
 

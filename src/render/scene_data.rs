@@ -97,6 +97,9 @@ pub struct SceneData {
     pub delta_lights: u32,
     /// World position of the render origin: every position above is relative to it (see `render_origin`).
     pub origin: Vec3,
+    /// Triangles outside the BVH, baked into the scene's pipeline as literals (`occluder_split`): `count` slots of
+    /// the per-triangle arrays from `first`, after the BVH's triangles. (0, 0) where the BVH holds every primitive.
+    pub occluders: (u32, u32),
     /// Largest |coordinate| of the geometry around `origin`, clamped to [1e-30, 1]: the length scale of
     /// ray-origin offsets near the origin (`FrameParams::offset_scale`).
     pub offset_scale: f32,
@@ -128,6 +131,12 @@ impl SceneData {
     /// `build`, making convex lamps of the emitter meshes that qualify (`accel::convex_lamps`) or keeping every
     /// emissive triangle a light of its own.
     pub fn build_with(scene: &Scene, convex_lamps: bool) -> SceneData {
+        SceneData::build_options(scene, BuildOptions { convex_lamps, baked_occluders: baked_occluders_on() })
+    }
+
+    /// `build` with each choice given (tests and A/B runs compare them on one scene).
+    pub fn build_options(scene: &Scene, options: BuildOptions) -> SceneData {
+        let convex_lamps = options.convex_lamps;
         let mut d = SceneData { origin: render_origin(scene), ..SceneData::default() };
         let o = d.origin;
         d.materials = scene.materials.iter().map(gpu_material).collect();
@@ -214,14 +223,30 @@ impl SceneData {
         } else {
             bvh::Presplit::Off
         };
-        let mut bvh = if bvh_layout_wide() {
-            bvh::build_wide(&tris, &d.spheres, &d.quads, presplit)
-        } else {
-            bvh::build(&tris, &d.spheres, &d.quads, presplit)
+        // A few occluders among many emitter triangles: the occluders are baked into the scene's pipeline and the
+        // BVH holds the emitters alone (`occluder_split`).
+        let any_alpha = scene.materials.iter().any(|m| m.alpha_texture.is_some());
+        let split = occluder_split(&keep_whole, d.spheres.len() + d.quads.len(), any_alpha, options.baked_occluders);
+        let in_bvh: Vec<usize> = match &split {
+            Some(occluders) => (0..tris.len()).filter(|i| !occluders.contains(i)).collect(),
+            None => (0..tris.len()).collect(),
         };
-        // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs.
+        let bvh_tris: Vec<[Vec3; 3]> = in_bvh.iter().map(|&i| tris[i]).collect();
+        let presplit = if split.is_some() { bvh::Presplit::Off } else { presplit };
+        let mut bvh = if bvh_layout_wide() {
+            bvh::build_wide(&bvh_tris, &d.spheres, &d.quads, presplit)
+        } else {
+            bvh::build(&bvh_tris, &d.spheres, &d.quads, presplit)
+        };
+        // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs. The baked
+        // occluders follow the BVH's triangles.
         d.triangles = tris.len();
-        let order = bvh::into_leaf_order(&mut bvh, tris.len());
+        let mut order: Vec<u32> =
+            bvh::into_leaf_order(&mut bvh, bvh_tris.len()).into_iter().map(|j| in_bvh[j as usize] as u32).collect();
+        if let Some(occluders) = &split {
+            d.occluders = (order.len() as u32, occluders.len() as u32);
+            order.extend(occluders.iter().map(|&i| i as u32));
+        }
         tris = order.iter().map(|&i| tris[i as usize]).collect();
         d.tri_verts = order.iter().flat_map(|&i| d.tri_verts[3 * i as usize..3 * i as usize + 3].to_vec()).collect();
         d.tri_shading = order.iter().map(|&i| d.tri_shading[i as usize]).collect();
@@ -318,6 +343,35 @@ impl SceneData {
             + self.prim_refs.len() * 4
             + std::mem::size_of_val(self.wide_nodes.as_slice())
     }
+}
+
+/// The triangles to bake into the pipeline instead of putting them in the BVH, or None: in a scene of more than
+/// `FLAT_MAX_PRIMS` primitives where at most that many triangles do not emit (`emits[i]`) and the rest are emitter
+/// triangles — Veach's plates and walls under 80,640 triangles of tessellated lamps — the non-emitters are tested
+/// as literals before the BVH (shaders/bvh.wgsl `bvh_traverse`), and the BVH holds the emitters alone. A camera ray
+/// or a shadow ray that meets no lamp's box then reads no node at all (baking removes the loads, which is what a
+/// ray costs on lavapipe: docs/profile-bvh.md). Not with spheres or quads (kept simple: the BVH stays
+/// triangle-only), cut-out masks (the baked tests have no alpha test), or without `on`.
+pub fn occluder_split(emits: &[bool], analytic_prims: usize, alpha: bool, on: bool) -> Option<Vec<usize>> {
+    let occluders: Vec<usize> = (0..emits.len()).filter(|&i| !emits[i]).collect();
+    let fits = !occluders.is_empty() && occluders.len() <= crate::render::baked::FLAT_MAX_PRIMS;
+    (on && fits && !alpha && analytic_prims == 0 && emits.len() > crate::render::baked::FLAT_MAX_PRIMS)
+        .then_some(occluders)
+}
+
+/// Whether scenes get their few occluders baked into their pipelines where `occluder_split` allows (the default):
+/// `MISLAB_BAKED_OCCLUDERS=0` keeps every primitive in the BVH, for A/B runs.
+pub fn baked_occluders_on() -> bool {
+    std::env::var("MISLAB_BAKED_OCCLUDERS").map_or(true, |v| v != "0")
+}
+
+/// The choices `SceneData::build_options` makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BuildOptions {
+    /// Make convex lamps of the emitter meshes that qualify (`accel::convex_lamps`).
+    pub convex_lamps: bool,
+    /// Bake a few occluders among many emitter triangles into the pipeline (`occluder_split`).
+    pub baked_occluders: bool,
 }
 
 /// Whether scenes get the 8-wide compressed BVH (the default) or the BVH2: `MISLAB_BVH=2` selects the BVH2, for

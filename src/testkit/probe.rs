@@ -45,7 +45,8 @@ pub const PROBE_RAY_WGSL: &str = "struct ProbeRay { o: vec3<f32>, t_max: f32, d:
 /// A tracing probe's module: the files traversal needs and `kernels` after [`PROBE_RAY_WGSL`]. Geometry only: no
 /// textures, so no cut-outs (alpha.wgsl needs the shading bindings).
 pub fn trace_module(kernels: &str) -> String {
-    let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n";
+    let no_alpha = "fn alpha_cut_out(prim: u32, b1: f32, b2: f32) -> bool { return false; }\n\
+                    fn occluder_range() -> vec2<u32> { return vec2<u32>(0u); }\n";
     crate::render::shaders::compose(
         &[
             "common.wgsl",
