@@ -303,6 +303,31 @@ fn found_emission(o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
     return r;
 }
 
+/// What a ray from o along w, traced only for the emission it finds (every direction sample in direct mode, a
+/// path's last), finds; p is the shading point it leaves. Towards a convex lamp's inner sphere it is traced only up
+/// to the lamp's stop box: if nothing is there, it finds the lamp (`lamp_in_sight`).
+fn found_emission_only(o: vec3<f32>, w: vec3<f32>, p: vec3<f32>) -> Found {
+    let sight = lamp_in_sight(o, w, p);
+    let hit = trace_closest(o, w, sight.t_box);
+    if (lamp_sighted(sight, hit)) {
+        return lamp_found(sight);
+    }
+    return found_emission(o, w, hit);
+}
+
+/// Whether a ray traced up to `sight`'s stop box found its lamp: nothing hit before the box.
+fn lamp_sighted(sight: LampSighting, hit: Hit) -> bool {
+    return sight.face != INVALID && hit.prim == INVALID;
+}
+
+/// The emission of a sighted lamp: found on one of its faces (which one is not needed: `lamp_in_sight`).
+fn lamp_found(sight: LampSighting) -> Found {
+    var r: Found;
+    r.light = sight.face;
+    r.le = sight.le;
+    return r;
+}
+
 /// Whether the measure of the first light sample at a shading point is that of any light its direction samples
 /// hit: one light (the one sampled), sampled at every vertex (not one-sample MIS). Saves a second
 /// spherical-polygon setup per vertex. Fixed per pipeline.
@@ -426,7 +451,7 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
             // Where the only emitters are a few convex lamps, a direction that meets none of them finds nothing.
             if (finds_no_emission(o, w)) { continue; }
             rays_traced += 1u;
-            let found = found_emission(o, w, trace_closest(o, w, F32_MAX));
+            let found = found_emission_only(o, w, c.x.p);
             if (all(found.le == vec3<f32>(0.0))) { continue; }
             let f = direction_f(c, ds);
             var mis = 1.0;

@@ -60,17 +60,22 @@ fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     let ray = *r;
     // A ray traced only for the emission it finds (a path's last, every direction sample in direct mode) finds none
     // where the scene's only emitters are a few convex lamps and it meets none of their stop boxes: not traced.
-    if (ray.bounce > 0u && ray.bounce >= depth && finds_no_emission(ray.o, ray.d)) { return false; }
+    let emission_only = ray.bounce > 0u && ray.bounce >= depth;
+    if (emission_only && finds_no_emission(ray.o, ray.d)) { return false; }
     rays_traced += 1u;
-    let hit = trace_closest(ray.o, ray.d, F32_MAX);
-    let found = found_emission(ray.o, ray.d, hit);
+    // Such a ray towards a convex lamp's inner sphere is traced only up to the lamp's box (`lamp_in_sight`).
+    var sight = LampSighting(INVALID, vec3<f32>(0.0), F32_MAX);
+    if (emission_only) { sight = lamp_in_sight(ray.o, ray.d, ray.from_p); }
+    let hit = trace_closest(ray.o, ray.d, sight.t_box);
+    var found: Found;
+    if (lamp_sighted(sight, hit)) { found = lamp_found(sight); } else { found = found_emission(ray.o, ray.d, hit); }
     // The camera ray is no direction technique's sample: its emission counts in full.
     var w = ray.emission_scale;
     if (ray.bounce > 0u && w > 0.0 && !ray.dir_delta && any(found.le != vec3<f32>(0.0))) {
         w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.from_transmits, ray.d, ray.light);
     }
     (*r).l += ray.beta * (w * found.le);
-    if (hit.prim == INVALID && ray.bounce > 0u && !ray.dir_delta) {
+    if (hit.prim == INVALID && !lamp_sighted(sight, hit) && ray.bounce > 0u && !ray.dir_delta) {
         env_guide_learn_escape(ray.from_p, env_receiver(ray.from_n, ray.from_transmits), ray.d);
     }
     if (hit.prim == INVALID || ray.bounce >= depth) { return false; }

@@ -537,6 +537,32 @@ fn ray_may_meet_a_lamp(o: vec3<f32>, d: vec3<f32>) -> bool {
     return false;
 }
 
+/// A convex lamp that a ray traced only for its emission meets for certain unless something comes before the lamp's
+/// stop box: its first face's light, the lamp's radiance and where the ray enters that box (`stop_box_entry`'s
+/// rounding), or INVALID and F32_MAX. The ray from o along d meets the lamp's inner sphere, so it meets the lamp's
+/// faces; nothing else is in the box (src/accel/isolated_emitters.rs); so if nothing is hit before the box, the
+/// first hit is a front face of the lamp, whose emission is the lamp's everywhere. Only in solid-angle mode and
+/// where d is in the cone from the shading point p as well: there the light technique's pdf of d does not depend
+/// on the face (`lamp_face_pdf_li`), so the face need not be found — a walk into the lamp's own thousands of
+/// triangles saved.
+struct LampSighting {
+    face: u32,
+    le: vec3<f32>,
+    t_box: f32,
+}
+fn lamp_in_sight(o: vec3<f32>, d: vec3<f32>, p: vec3<f32>) -> LampSighting {
+    var s = LampSighting(INVALID, vec3<f32>(0.0), F32_MAX);
+    if (!LAMP_SIGHTING || params.lamp_count > MAX_LAMPS_TESTED || cfg_light_sampling() != LIGHT_SAMPLING_SOLID_ANGLE) { return s; }
+    for (var k = 0u; k < params.lamp_count; k += 1u) {
+        let l = scene_light(params.lamp_first + k);
+        if (!lamp_in_cone(l, o, d) || !lamp_in_cone(l, p, d)) { continue; }
+        let b = box_slabs(l.position, l.direction, o, d);
+        let entry = max(max(b.near.x, b.near.y), b.near.z) * (1.0 + 1e-5);
+        if (entry > 0.0 && entry < s.t_box) { s = LampSighting(l.prim, l.radiance, entry); }
+    }
+    return s;
+}
+
 /// The light a light found by a ray counts as when chosen: a lamp's face (the entries from num_lights on) its lamp.
 fn chosen_light(i: u32) -> u32 {
     if (!HAS_CONVEX_LAMPS || i == INVALID || i < params.num_lights) { return i; }

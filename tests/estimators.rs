@@ -1100,10 +1100,13 @@ fn light_tree_and_ris_agree_on_the_veach_gltf_scene() {
 // Convex lamps (src/accel/convex_lamps.rs)
 
 /// A coarsely tessellated sphere lamp (120 faces: the rim outside its inner sphere is 13 % of its silhouette) over
-/// a grey floor, in front of a grey wall.
+/// a grey floor, in front of a grey wall, with a shelf between the lamp and the floor: rays towards the lamp that
+/// the shelf blocks before the lamp's box (shaders/lights.wgsl `lamp_in_sight`). Six occluder triangles among 120
+/// emitters: the occluders are baked (src/render/scene_data.rs `occluder_split`).
 fn lamp_room() -> Scene {
     let floor = rect(Vec3::new(-3.0, 0.0, 2.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0));
     let wall = rect(Vec3::new(-3.0, 0.0, -2.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
+    let shelf = rect(Vec3::new(0.05, 0.4, -0.35), Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.5));
     Scene {
         name: "lamp-room".into(),
         materials: vec![Material::emitter("lamp", Vec3::splat(6.0)), Material::lambert("grey", Vec3::splat(0.5))],
@@ -1111,6 +1114,7 @@ fn lamp_room() -> Scene {
             mesh_of("lamp", &uv_sphere(Vec3::new(0.3, 0.9, -0.6), 0.35, 6, 12, true), 0),
             mesh_of("floor", &floor, 1),
             mesh_of("wall", &wall, 1),
+            mesh_of("shelf", &shelf, 1),
         ],
         camera: Camera::look_at(Vec3::new(0.0, 1.6, 4.0), Vec3::new(0.0, 0.7, -0.5), Vec3::Y, 45.0),
         ..Default::default()
