@@ -140,11 +140,28 @@ fn struct_lit(name: &str, members: &[String], words: &[u32]) -> Option<String> {
 /// entry 0, as a clamped buffer read would give some entry), or reading `buffer_read` when an entry cannot be
 /// written as literals or there is none.
 fn accessor<T: bytemuck::Pod>(name: &str, ty: &str, members: &[String], items: &[T], buffer_read: &str) -> String {
+    literal_accessor(name, ty, members, items, buffer_read, false)
+}
+
+/// `accessor`, or with `buffer_beyond` one that reads `buffer_read` for i ≥ items.len() (where a table's first
+/// entries are few and read often: a scene's lamps before their faces).
+fn literal_accessor<T: bytemuck::Pod>(
+    name: &str,
+    ty: &str,
+    members: &[String],
+    items: &[T],
+    buffer_read: &str,
+    buffer_beyond: bool,
+) -> String {
     let lits: Option<Vec<String>> =
         items.iter().map(|x| struct_lit(ty, members, bytemuck::cast_slice(std::slice::from_ref(x)))).collect();
     match lits {
         Some(l) if !l.is_empty() => {
-            let mut f = format!("fn {name}(i: u32) -> {ty} {{\n    var x = {};\n", l[0]);
+            let mut f = format!("fn {name}(i: u32) -> {ty} {{\n");
+            if buffer_beyond {
+                let _ = writeln!(f, "    if i >= {}u {{ return {buffer_read}; }}", l.len());
+            }
+            let _ = writeln!(f, "    var x = {};", l[0]);
             for (k, e) in l.iter().enumerate().skip(1) {
                 let _ = writeln!(f, "    if (i == {k}u) {{ x = {e}; }}");
             }
@@ -195,34 +212,6 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     Some((out, baked_traverse_source(data, 0..data.tri_shading.len(), true) + BUFFER_ROOT))
 }
 
-/// `fn name(i: u32) -> ty` returning entry i of `items` through a chain of selections for i < items.len(), and
-/// reading `buffer_read` beyond (where a table's first entries are few and read often: a scene's lamps before
-/// their faces). The whole function reads the buffer when an entry cannot be written as literals.
-fn accessor_prefix<T: bytemuck::Pod>(
-    name: &str,
-    ty: &str,
-    members: &[String],
-    items: &[T],
-    buffer_read: &str,
-) -> String {
-    let lits: Option<Vec<String>> =
-        items.iter().map(|x| struct_lit(ty, members, bytemuck::cast_slice(std::slice::from_ref(x)))).collect();
-    match lits {
-        Some(l) if !l.is_empty() => {
-            let mut f = format!(
-                "fn {name}(i: u32) -> {ty} {{\n    if i >= {}u {{ return {buffer_read}; }}\n    var x = {};\n",
-                l.len(),
-                l[0]
-            );
-            for (k, e) in l.iter().enumerate().skip(1) {
-                let _ = writeln!(f, "    if (i == {k}u) {{ x = {e}; }}");
-            }
-            f + "    return x;\n}\n"
-        }
-        _ => format!("fn {name}(i: u32) -> {ty} {{ return {buffer_read}; }}\n"),
-    }
-}
-
 /// Most materials, and most lights that selection chooses among, a scene with baked occluders has as literals.
 const LITERAL_TABLE_MAX: usize = 32;
 
@@ -237,7 +226,7 @@ pub fn occluder_scene_data_source(data: &SceneData) -> Option<String> {
     }
     let n = data.selectable_lights();
     if n <= LITERAL_TABLE_MAX {
-        let f = accessor_prefix("scene_light", "Light", &wgsl_members("Light"), &data.lights[..n], "lights[i]");
+        let f = literal_accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights[..n], "lights[i]", true);
         out = out.replace("fn scene_light(i: u32) -> Light { return lights[i]; }\n", &f);
     }
     // The occluders' positions, corners (record indices, as the buffer's w words hold them) and shading records:
