@@ -218,7 +218,7 @@ const LITERAL_TABLE_MAX: usize = 32;
 /// The generated `scene_data.wgsl` of a scene with baked occluders: the buffer-reading one with the materials and
 /// the lights that selection chooses among (its few lamps, not their faces) as literals when they are few.
 pub fn occluder_scene_data_source(data: &SceneData) -> Option<String> {
-    occluder_source(data)?;
+    baked_occluders(data).then_some(())?;
     let mut out = crate::render::shaders::file("scene_data.wgsl").to_string();
     if data.materials.len() <= LITERAL_TABLE_MAX {
         let f = accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
@@ -273,6 +273,11 @@ pub fn occluder_scene_data_source(data: &SceneData) -> Option<String> {
         out = out.replace(head, &format!("{head}\n    {body}"));
     }
     Some(out)
+}
+
+/// Whether `data`'s pipelines bake its occluders (`SceneData::occluders`; a scene baked whole needs no split).
+pub fn baked_occluders(data: &SceneData) -> bool {
+    data.occluders.1 > 0 && flat_counts(data).is_none()
 }
 
 /// The root functions of baked_geometry.wgsl as they read the wide BVH's root node from its buffer.
@@ -352,7 +357,7 @@ fn baked_root_source(data: &SceneData, root: &crate::accel::wide_bvh::GpuWideNod
 /// The generated `light_tree_loads.wgsl` of a scene with baked occluders and a light tree of at most
 /// `LITERAL_TABLE_MAX` nodes (its few lamps): every node a literal. None otherwise.
 pub fn occluder_light_tree_source(data: &SceneData) -> Option<String> {
-    occluder_source(data)?;
+    baked_occluders(data).then_some(())?;
     let n = data.light_tree.len();
     if n == 0 || n > LITERAL_TABLE_MAX {
         return None;
@@ -364,10 +369,10 @@ pub fn occluder_light_tree_source(data: &SceneData) -> Option<String> {
 /// The generated `baked_geometry.wgsl` of a scene with baked occluders (`SceneData::occluders`): the tests of
 /// those triangles alone, run before the BVH; None when the scene has none (or is baked whole).
 pub fn occluder_source(data: &SceneData) -> Option<String> {
-    let (first, count) = (data.occluders.0 as usize, data.occluders.1 as usize);
-    if count == 0 || flat_counts(data).is_some() {
+    if !baked_occluders(data) {
         return None;
     }
+    let (first, count) = (data.occluders.0 as usize, data.occluders.1 as usize);
     let mut out = baked_traverse_source(data, first..first + count, false);
     out += &match data.wide_nodes.first() {
         Some(root) => baked_root_source(data, root),

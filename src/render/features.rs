@@ -152,7 +152,7 @@ impl Features {
             alpha,
             // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
             flat: crate::render::baked::flat_counts(data).filter(|_| !alpha),
-            occluders: crate::render::baked::occluder_source(data).map_or(0, |_| data.occluders.1),
+            occluders: if crate::render::baked::baked_occluders(data) { data.occluders.1 } else { 0 },
             baked: crate::render::render_module::baked_sources(data).map_or(0, |src| {
                 use std::hash::{Hash, Hasher};
                 let mut h = std::collections::hash_map::DefaultHasher::new();
