@@ -280,6 +280,44 @@ pub fn baked_occluders(data: &SceneData) -> bool {
     data.occluders.1 > 0 && flat_counts(data).is_none()
 }
 
+/// Whether `data`'s own pipelines test its wide BVH's root children against their exact boxes, as literals
+/// (`baked_root_source`), instead of loading the root node: one node load less per ray, and exact boxes instead of
+/// 8-bit ones rounded outwards by up to 1/255 of the root's extent per axis — in a scene whose root spans a large
+/// floor around a small object, each of the object's subtrees is entered by rays that pass well beside it
+/// (docs/profile-bvh.md, "The root as literals"). Where the BVH holds triangles only: the boxes are computed from
+/// the leaf-order triangles (with spheres or quads in the tree its entries are not triangle slots). Always with
+/// baked occluders, where the root stops a ray at a lamp's exact box.
+pub fn baked_root(data: &SceneData) -> bool {
+    let triangles_only = data.spheres.is_empty() && data.quads.is_empty();
+    flat_counts(data).is_none()
+        && !data.wide_nodes.is_empty()
+        && triangles_only
+        && (data.baked_root || baked_occluders(data))
+}
+
+/// The generated `baked_geometry.wgsl` of a BVH scene whose root alone is baked (`baked_root`, no baked
+/// occluders): nothing to test before the BVH, and the root's boxes as literals. None otherwise.
+pub fn root_source(data: &SceneData) -> Option<String> {
+    if !baked_root(data) || baked_occluders(data) {
+        return None;
+    }
+    Some(String::from(NO_BAKED_PRIMITIVES) + &baked_root_source(data, &data.wide_nodes[0]))
+}
+
+/// baked_geometry.wgsl's primitive tests in a pipeline that has no baked primitives (FLAT_SCENE and
+/// BAKED_OCCLUDERS are false there, so nothing calls them; they only have to exist).
+const NO_BAKED_PRIMITIVES: &str =
+    "// baked_geometry.wgsl, generated for one scene by src/render/baked.rs: its BVH root's boxes.
+
+fn baked_traverse(r: TraceRay, start: Hit, skip: u32) -> Hit {
+    return start;
+}
+
+fn baked_occluded(r: TraceRay, t_max: f32, skip: u32) -> bool {
+    return false;
+}
+";
+
 /// The root functions of baked_geometry.wgsl as they read the wide BVH's root node from its buffer.
 const BUFFER_ROOT: &str = "
 fn baked_wide_root() -> WideNode {

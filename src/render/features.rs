@@ -76,6 +76,8 @@ pub struct Features {
     /// Triangles tested as literals before the BVH, which holds the rest (`SceneData::occluders`); 0 = none;
     /// `GENERIC_OCCLUDERS`: read from the frame parameters and tested in a loop (the generic pipeline).
     pub occluders: u32,
+    /// The wide BVH's root children are tested against their exact boxes as literals (`baked::baked_root`).
+    pub baked_root: bool,
     /// For flat scenes, a hash of the scene data baked into its pipelines' source (src/render/baked.rs), so that a
     /// pipeline cache never hands one scene's baked pipeline to another; 0 otherwise.
     pub baked: u64,
@@ -111,6 +113,7 @@ impl Features {
             flat: None,
             // The generic pipeline tests a scene's occluders in a loop over their buffer slots (baked_geometry.wgsl).
             occluders: GENERIC_OCCLUDERS,
+            baked_root: false,
             baked: 0,
         }
     }
@@ -153,6 +156,7 @@ impl Features {
             // The baked traversal has no alpha test: scenes with cut-outs take the BVH.
             flat: crate::render::baked::flat_counts(data).filter(|_| !alpha),
             occluders: if crate::render::baked::baked_occluders(data) { data.occluders.1 } else { 0 },
+            baked_root: crate::render::baked::baked_root(data),
             baked: crate::render::render_module::baked_sources(data).map_or(0, |src| {
                 use std::hash::{Hash, Hasher};
                 let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -190,7 +194,7 @@ impl Features {
             ("FLAT_SCENE", b(self.flat.is_some())),
             ("WIDE_BVH", b(self.wide_bvh)),
             ("BAKED_OCCLUDERS", b(self.occluders > 0)),
-            ("BAKED_ROOT", b(self.occluders > 0 && self.occluders != GENERIC_OCCLUDERS)),
+            ("BAKED_ROOT", b(self.baked_root)),
             // Not in the generic pipeline: its compilation is minutes already, and this changes no pixel.
             ("LAMP_SIGHTING", b(self.convex_lamps && self.occluders != GENERIC_OCCLUDERS)),
         ]
@@ -225,6 +229,7 @@ impl Features {
         on("light selection", self.many_lights);
         on("alpha cut-outs", self.alpha);
         on("8-wide compressed BVH", self.wide_bvh && self.flat.is_none());
+        on("the BVH root's boxes as literals", self.baked_root);
         if let Some((t, s, q)) = self.flat {
             v.push(format!("scene baked into the shader ({t} triangles, {s} spheres, {q} quads as literals; no BVH)"));
         }

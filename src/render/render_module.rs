@@ -45,6 +45,9 @@ pub fn baked_sources(data: &crate::render::scene_data::SceneData) -> Option<Vec<
     if let Some((data, geometry)) = crate::render::baked::scene_data_source(data) {
         return Some(vec![("scene_data.wgsl", data), ("baked_geometry.wgsl", geometry)]);
     }
+    if let Some(root) = crate::render::baked::root_source(data) {
+        return Some(vec![("baked_geometry.wgsl", root)]);
+    }
     let geometry = crate::render::baked::occluder_source(data)?;
     let tables = crate::render::baked::occluder_scene_data_source(data)?;
     let mut files = vec![("scene_data.wgsl", tables), ("baked_geometry.wgsl", geometry)];

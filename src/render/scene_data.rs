@@ -100,6 +100,10 @@ pub struct SceneData {
     /// Triangles outside the BVH, baked into the scene's pipeline as literals (`occluder_split`): `count` slots of
     /// the per-triangle arrays from `first`, after the BVH's triangles. (0, 0) where the BVH holds every primitive.
     pub occluders: (u32, u32),
+    /// Whether this scene's own pipelines test its wide BVH's root children against their exact boxes as literals
+    /// (`baked::baked_root`, where the BVH holds triangles only). A choice, kept here with the scene it was made for:
+    /// `BuildOptions::baked_root`.
+    pub baked_root: bool,
     /// Largest |coordinate| of the geometry around `origin`, clamped to [1e-30, 1]: the length scale of
     /// ray-origin offsets near the origin (`FrameParams::offset_scale`).
     pub offset_scale: f32,
@@ -131,13 +135,16 @@ impl SceneData {
     /// `build`, making convex lamps of the emitter meshes that qualify (`accel::convex_lamps`) or keeping every
     /// emissive triangle a light of its own.
     pub fn build_with(scene: &Scene, convex_lamps: bool) -> SceneData {
-        SceneData::build_options(scene, BuildOptions { convex_lamps, baked_occluders: baked_occluders_on() })
+        SceneData::build_options(
+            scene,
+            BuildOptions { convex_lamps, baked_occluders: baked_occluders_on(), baked_root: baked_root_on() },
+        )
     }
 
     /// `build` with each choice given (tests and A/B runs compare them on one scene).
     pub fn build_options(scene: &Scene, options: BuildOptions) -> SceneData {
         let convex_lamps = options.convex_lamps;
-        let mut d = SceneData { origin: render_origin(scene), ..SceneData::default() };
+        let mut d = SceneData { origin: render_origin(scene), baked_root: options.baked_root, ..SceneData::default() };
         let o = d.origin;
         d.materials = scene.materials.iter().map(gpu_material).collect();
         if d.materials.is_empty() {
@@ -365,6 +372,12 @@ pub fn baked_occluders_on() -> bool {
     std::env::var("MISLAB_BAKED_OCCLUDERS").map_or(true, |v| v != "0")
 }
 
+/// Whether scenes' own pipelines get their BVH root's boxes as literals (`baked::baked_root`; the default):
+/// `MISLAB_BAKED_ROOT=0` reads the root from its buffer like every other node, for A/B runs.
+pub fn baked_root_on() -> bool {
+    std::env::var("MISLAB_BAKED_ROOT").map_or(true, |v| v != "0")
+}
+
 /// The choices `SceneData::build_options` makes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BuildOptions {
@@ -372,6 +385,8 @@ pub struct BuildOptions {
     pub convex_lamps: bool,
     /// Bake a few occluders among many emitter triangles into the pipeline (`occluder_split`).
     pub baked_occluders: bool,
+    /// Test the wide BVH root's children against literal boxes in the scene's own pipelines (`baked::baked_root`).
+    pub baked_root: bool,
 }
 
 /// Whether scenes get the 8-wide compressed BVH (the default) or the BVH2: `MISLAB_BVH=2` selects the BVH2, for
