@@ -356,8 +356,8 @@ override FLAT_SCENE: bool = false;
 /// `occluder_split`).
 override BAKED_OCCLUDERS: bool = false;
 /// The wide BVH's root children tested against their exact boxes, as literals, before the traversal loop
-/// (bvh_wide.wgsl; src/render/baked.rs `baked_root`): in a scene's own pipeline where the BVH holds triangles only,
-/// not in the generic one (which would only read the root node outside the loop instead of in it).
+/// (bvh_wide.wgsl; src/render/baked.rs `baked_root`): in a scene's own pipeline, not in the generic one (which
+/// would only read the root node outside the loop instead of in it).
 override BAKED_ROOT: bool = false;
 /// Rays traced only for their emission stop at a convex lamp's box where they meet its inner sphere
 /// (lights.wgsl `lamp_in_sight`): in a scene's own pipeline.

@@ -16,7 +16,7 @@ use mislab::render::gpu_scene::GpuScene;
 use mislab::render::scene_data::{BuildOptions, SceneData};
 use mislab::render::settings::{LightSelect, Mode, Settings, Strategy};
 use mislab::render::Renderer;
-use mislab::scene::{Camera, Environment, Material, Scene};
+use mislab::scene::{Camera, Environment, Material, Quad, Scene, Sphere};
 
 use common::{mesh_of, rect, uv_sphere};
 
@@ -155,8 +155,9 @@ fn light_sampling_agrees_in_distribution() {
 }
 
 /// A small bumpy object on a floor forty times its size under a white sky (the bench's scaling scenes in small):
-/// the root's 8-bit boxes are coarse around the object, its exact ones are not.
-fn object_on_a_floor() -> Scene {
+/// the root's 8-bit boxes are coarse around the object, its exact ones are not. With `analytic`, an analytic
+/// sphere and quad beside it (the BVH's entries then reach their primitives through references).
+fn object_on_a_floor(analytic: bool) -> Scene {
     let floor = rect(Vec3::new(-20.0, 0.0, 20.0), Vec3::new(40.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -40.0));
     Scene {
         name: "object-on-a-floor".into(),
@@ -166,6 +167,17 @@ fn object_on_a_floor() -> Scene {
             mesh_of("ball", &uv_sphere(Vec3::new(0.0, 0.5, 0.0), 0.5, 12, 24, true), 0),
             mesh_of("pebble", &uv_sphere(Vec3::new(0.8, 0.15, 0.3), 0.15, 6, 12, true), 0),
         ],
+        spheres: if analytic {
+            vec![Sphere { center: Vec3::new(-0.7, 0.25, 0.4), radius: 0.25, material: 0 }]
+        } else {
+            vec![]
+        },
+        quads: if analytic {
+            let (corner, edge_u, edge_v) = (Vec3::new(-0.6, 0.0, -0.6), Vec3::new(0.5, 0.0, -0.2), Vec3::Y * 0.6);
+            vec![Quad { corner, edge_u, edge_v, material: 0 }]
+        } else {
+            vec![]
+        },
         camera: Camera::look_at(Vec3::new(1.5, 1.2, 2.5), Vec3::new(0.0, 0.4, 0.0), Vec3::Y, 40.0),
         environment: Environment::Constant(Vec3::ONE),
         ..Default::default()
@@ -173,14 +185,26 @@ fn object_on_a_floor() -> Scene {
 }
 
 /// The root's children tested against their exact boxes as literals give the pixels that loading the root node
-/// gives, in path tracing with MIS (closest hits and shadow rays) and with BSDF samples alone.
+/// gives, in path tracing with MIS (closest hits and shadow rays) and with BSDF samples alone, in a triangle scene
+/// and in one with an analytic sphere and quad.
 #[test]
 fn same_pixels_with_the_bvh_root_as_literals() {
-    let scene = object_on_a_floor();
+    for analytic in [false, true] {
+        same_pixels_with_the_root_as_literals_in(object_on_a_floor(analytic));
+    }
+}
+
+fn same_pixels_with_the_root_as_literals_in(scene: Scene) {
     let build = |baked_root| {
         SceneData::build_options(&scene, BuildOptions { convex_lamps: true, baked_occluders: true, baked_root })
     };
     let (on, off) = (build(true), build(false));
+    let analytic = !scene.spheres.is_empty();
+    assert_eq!(
+        on.prim_refs != mislab::render::scene_data::IDENTITY_PRIM_REFS,
+        analytic,
+        "references where not all triangles"
+    );
     let children = (0..WIDTH).filter(|&i| !matches!(on.wide_nodes[0].child(i), WideChild::Empty)).count();
     assert!(children > 1, "the root has children to test");
     assert!(Features::of(&on).baked_root && !Features::of(&off).baked_root);
@@ -190,12 +214,15 @@ fn same_pixels_with_the_bvh_root_as_literals() {
         let settings = Settings { mode: Mode::Path, max_depth: 4, rr_depth: 8, strategy, ..common::small(48, 32) };
         let a = render(&scene, on.clone(), &settings, true, 16);
         let b = render(&scene, off.clone(), &settings, true, 16);
-        assert!(a.nonfinite.iter().all(|&n| n == 0), "{strategy:?}: no NaN/Inf samples");
+        assert!(a.nonfinite.iter().all(|&n| n == 0), "analytic {analytic}, {strategy:?}: no NaN/Inf samples");
         let shadowed = a.mean.iter().filter(|p| p[0] > 0.0 && p[0] < 0.4).count();
-        assert!(shadowed > 20, "{strategy:?}: the object shadows the floor ({shadowed} pixels)");
+        assert!(shadowed > 20, "{strategy:?}: the objects shadow the floor ({shadowed} pixels)");
         // A tie between two triangles at one t may go the other way in another visiting order and move a later
         // vertex by an ulp: a few pixels may differ a little.
         let w = worst(&a, &b);
-        assert!(w.0 < 2e-2, "{strategy:?}: the literal root changes the image by {w:?} (relative, pixel, values)");
+        assert!(
+            w.0 < 2e-2,
+            "analytic {analytic}, {strategy:?}: the literal root changes the image by {w:?} (relative, pixel, values)"
+        );
     }
 }

@@ -13,6 +13,7 @@
 //! The storage buffers stay bound: shading (`surface_at`) reads them once per hit, and the generic pipeline (the
 //! viewer's) never calls the baked function.
 
+use crate::accel::bvh;
 use crate::accel::convex_solids::convex_solids;
 use crate::gpu::types::*;
 use crate::render::scene_data::SceneData;
@@ -182,7 +183,7 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     // Positions as f32 bits, then the corners' shading-vertex indices (the layout of scene_data.wgsl's struct).
     let positions: Vec<[u32; 12]> = (0..data.tri_shading.len())
         .map(|i| {
-            let v = |k: usize| data.tri_verts[3 * i + k].map(f32::to_bits);
+            let v = |k: usize| data.tri_vertex(3 * i + k).map(f32::to_bits);
             let (a, b, c, s) = (v(0), v(1), v(2), data.tri_shading[i].corners);
             [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], s[0], s[1], s[2]]
         })
@@ -232,7 +233,7 @@ pub fn occluder_scene_data_source(data: &SceneData) -> Option<String> {
     // The occluders' positions, corners (record indices, as the buffer's w words hold them) and shading records:
     // what shading a hit on one reads.
     let (first, count) = (data.occluders.0 as usize, data.occluders.1 as usize);
-    let words = |i: usize, k: usize| data.tri_verts[3 * i + k].map(f32::to_bits);
+    let words = |i: usize, k: usize| data.tri_vertex(3 * i + k).map(f32::to_bits);
     let positions: Vec<[u32; 12]> = (first..first + count)
         .map(|i| {
             let (a, b, c) = (words(i, 0), words(i, 1), words(i, 2));
@@ -284,15 +285,10 @@ pub fn baked_occluders(data: &SceneData) -> bool {
 /// (`baked_root_source`), instead of loading the root node: one node load less per ray, and exact boxes instead of
 /// 8-bit ones rounded outwards by up to 1/255 of the root's extent per axis — in a scene whose root spans a large
 /// floor around a small object, each of the object's subtrees is entered by rays that pass well beside it
-/// (docs/profile-bvh.md, "The root as literals"). Where the BVH holds triangles only: the boxes are computed from
-/// the leaf-order triangles (with spheres or quads in the tree its entries are not triangle slots). Always with
-/// baked occluders, where the root stops a ray at a lamp's exact box.
+/// (docs/profile-bvh.md, "The root as literals"). Always with baked occluders, where the root stops a ray at a
+/// lamp's exact box.
 pub fn baked_root(data: &SceneData) -> bool {
-    let triangles_only = data.spheres.is_empty() && data.quads.is_empty();
-    flat_counts(data).is_none()
-        && !data.wide_nodes.is_empty()
-        && triangles_only
-        && (data.baked_root || baked_occluders(data))
+    flat_counts(data).is_none() && !data.wide_nodes.is_empty() && (data.baked_root || baked_occluders(data))
 }
 
 /// The generated `baked_geometry.wgsl` of a BVH scene whose root alone is baked (`baked_root`, no baked
@@ -345,14 +341,26 @@ fn baked_root_source(data: &SceneData, root: &crate::accel::wide_bvh::GpuWideNod
         v(3),
         v(4)
     );
-    // The triangles' box of leaf-order entries first..first + count (the BVH is triangle-only: entry j is triangle j).
+    // The box of leaf-order entries first..first + count: each entry's primitive (the reference itself where the
+    // leaf order is the triangle order) bounded as the BVH build bounds it — a triangle by its f32 vertices, which
+    // the traversal tests, a sphere or quad rounded outwards.
+    let identity = data.prim_refs == crate::render::scene_data::IDENTITY_PRIM_REFS;
     let leaf_box = |first: u32, count: u32, b: &mut (Vec3, Vec3)| {
         for j in first..first + count {
-            for k in 0..3 {
-                let p = data.tri_verts[3 * j as usize + k];
-                let p = Vec3::new(p[0], p[1], p[2]);
-                b.0 = b.0.min(p);
-                b.1 = b.1.max(p);
+            let prim = if identity { make_prim(PRIM_TRIANGLE, j) } else { data.prim_refs[j as usize] };
+            let i = (prim & PRIM_INDEX_MASK) as usize;
+            let bounds = match prim >> PRIM_KIND_SHIFT {
+                PRIM_TRIANGLE => {
+                    let p = |k: usize| Vec3::from_slice(&data.tri_vertex(3 * i + k)[..3]);
+                    bvh::triangle_aabb(&[p(0), p(1), p(2)])
+                }
+                PRIM_SPHERE => bvh::sphere_aabb(&data.spheres[i]),
+                _ => bvh::quad_aabb(&data.quads[i]),
+            };
+            // Every entry in a leaf has a box (the build leaves out the primitives that have none).
+            if let Some(a) = bounds {
+                b.0 = b.0.min(a.min);
+                b.1 = b.1.max(a.max);
             }
         }
     };
@@ -381,6 +389,10 @@ fn baked_root_source(data: &SceneData, root: &crate::accel::wide_bvh::GpuWideNod
                 0
             }
         };
+        // Within the node's own (conservative) 8-bit box as well: a pre-split triangle's entry stands for the piece
+        // inside that box (`accel::presplit`), and its whole triangle may reach far beyond it.
+        let q = root.child_box(slot);
+        b = (b.0.max(q.min), b.1.min(q.max));
         let hit_bits = if bits == 0 { format!("1u << (24u + ({slot}u ^ oct))") } else { format!("{bits}u") };
         let _ = writeln!(
             out,
@@ -446,15 +458,16 @@ enum Query {
 /// Appends the tests for `query` of triangles `tris` and, with `analytic`, of every sphere and quad.
 fn primitive_tests(data: &SceneData, out: &mut String, query: Query, tris: std::ops::Range<usize>, analytic: bool) {
     let first = tris.start;
-    let mesh = MeshTopology::of(&data.tri_verts[3 * first..], tris.len());
+    // The triangles' vertices, wherever they are (a scene's occluders follow its BVH's triangles, which may span
+    // several vertex bindings).
+    let verts: Vec<[f32; 4]> = (3 * first..3 * tris.end).map(|k| data.tri_vertex(k)).collect();
+    let mesh = MeshTopology::of(&verts, tris.len());
     // Each vertex and edge is emitted just before the first triangle that needs it, so fewer values are live
     // at once (spilling them costs more than recomputing would).
     let (mut have_v, mut have_e) = (vec![false; mesh.vertices.len()], vec![false; mesh.edges.len()]);
     // Shadow rays test closed convex meshes (not lights) as solids: a few plane clips instead of their triangles.
     let solids = match query {
-        Query::Occluded => {
-            convex_solids(&data.tri_verts[3 * first..], tris.len(), |t| data.tri_shading[first + t].light != INVALID)
-        }
+        Query::Occluded => convex_solids(&verts, tris.len(), |t| data.tri_shading[first + t].light != INVALID),
         Query::Closest => vec![],
     };
     let in_solid: Vec<bool> =

@@ -101,8 +101,7 @@ pub struct SceneData {
     /// the per-triangle arrays from `first`, after the BVH's triangles. (0, 0) where the BVH holds every primitive.
     pub occluders: (u32, u32),
     /// Whether this scene's own pipelines test its wide BVH's root children against their exact boxes as literals
-    /// (`baked::baked_root`, where the BVH holds triangles only). A choice, kept here with the scene it was made for:
-    /// `BuildOptions::baked_root`.
+    /// (`baked::baked_root`). A choice, kept here with the scene it was made for: `BuildOptions::baked_root`.
     pub baked_root: bool,
     /// Largest |coordinate| of the geometry around `origin`, clamped to [1e-30, 1]: the length scale of
     /// ray-origin offsets near the origin (`FrameParams::offset_scale`).
@@ -306,6 +305,19 @@ impl SceneData {
         } else {
             2
         }
+    }
+
+    /// Vertex `k` of the per-triangle arrays (triangle k / 3), wherever it is: in `tri_verts` or, past one binding,
+    /// in a part of `tri_verts_hi`.
+    pub fn tri_vertex(&self, k: usize) -> [f32; 4] {
+        let mut k = k;
+        for part in std::iter::once(&self.tri_verts).chain(&self.tri_verts_hi) {
+            if k < part.len() {
+                return part[k];
+            }
+            k -= part.len();
+        }
+        panic!("vertex {k} past the last of the split parts")
     }
 
     /// Nodes of the BVH in use, and its kind ("8-wide" or "binary").
