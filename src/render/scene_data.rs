@@ -310,14 +310,14 @@ impl SceneData {
     /// Vertex `k` of the per-triangle arrays (triangle k / 3), wherever it is: in `tri_verts` or, past one binding,
     /// in a part of `tri_verts_hi`.
     pub fn tri_vertex(&self, k: usize) -> [f32; 4] {
-        let mut k = k;
+        let mut rest = k;
         for part in std::iter::once(&self.tri_verts).chain(&self.tri_verts_hi) {
-            if k < part.len() {
-                return part[k];
+            if rest < part.len() {
+                return part[rest];
             }
-            k -= part.len();
+            rest -= part.len();
         }
-        panic!("vertex {k} past the last of the split parts")
+        panic!("vertex {k} is past the scene's {} vertices", k - rest)
     }
 
     /// Nodes of the BVH in use, and its kind ("8-wide" or "binary").
