@@ -6,10 +6,12 @@
 //!
 //! The folders are the layers, each using only those below it: [`io`] (files) and [`gpu`] (the device and the
 //! structs shared with WGSL) at the bottom; [`scene`] (loaders) and [`accel`] (BVH, light tree) on
-//! them; [`render`] (the renderer); [`state`] (checkpointed and split renders); [`lab`] (bench, references,
-//! figures, stress) and [`viewer`] at the top. [`testkit`] (chi-square, probes, metrics) serves the tests and the lab.
+//! them; [`render`] (the renderer); [`state`] (checkpointed and split renders); [`api`] (the one embeddable API
+//! every front end stands on: a lab, scene handles, `render(...) -> Image`, one loop for every budget); [`lab`]
+//! (bench, references, figures, stress) and [`viewer`] at the top. [`testkit`] (chi-square, probes, metrics) serves the tests and the lab.
 
 pub mod accel;
+pub mod api;
 pub mod gpu;
 pub mod io;
 pub mod lab;

@@ -1,18 +1,15 @@
 //! The `mislab` command line: render, info (and the subcommands later issues add).
 
 use clap::{Args, Parser, Subcommand};
+use mislab::api::{self, Tonemap};
 use mislab::gpu::{self, GpuContext};
-use mislab::render::film::Tonemap;
-use mislab::render::progressive::{self, Budget};
-use mislab::render::settings::*;
-use mislab::render::Renderer;
-use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
+use mislab::render::scene_data::SceneData;
 use mislab::scene::{self, Environment, SceneSpec};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Exit code for bad input, a missing GPU, or a scene the device cannot hold.
 const EXIT_BAD_INPUT: u8 = 2;
@@ -76,21 +73,13 @@ struct RenderArgs {
     /// Replace the output file even if it is read-only.
     #[arg(long)]
     force: bool,
-    /// Samples per pixel [default: 64 unless --time is given].
-    #[arg(long, conflicts_with = "time", value_parser = mislab::io::cli_values::spp)]
-    spp: Option<u32>,
-    /// Render for this many seconds (after start-up and shader compilation).
-    #[arg(long, value_parser = mislab::io::cli_values::seconds)]
-    time: Option<f64>,
     /// Tonemapper for PNG output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
     tonemap: Tonemap,
-    /// Estimator settings: the same names as the viewer panel and benchmark files.
+    /// Budget, estimator settings and state files: the same names as the viewer panel, benchmark files and
+    /// Python's keyword arguments.
     #[command(flatten)]
-    settings: Settings,
-    /// State files, checkpoints, resume and parts (src/state).
-    #[command(flatten)]
-    state: mislab::state::session::StateArgs,
+    flags: api::RenderFlags,
 }
 
 impl Default for RenderArgs {
@@ -172,34 +161,21 @@ fn stress(filter: Option<&str>) -> Result<u8, Failure> {
 }
 
 fn render(args: RenderArgs) -> Result<u8, Failure> {
-    let mut settings = args.settings.clone();
-    settings.validate().map_err(bad)?;
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    args.flags.settings.validate().map_err(bad)?;
     if !matches!(ext.as_deref(), Some("png") | Some("exr")) {
         return Err(bad(format!("{}: unknown output format (use .png or .exr)", args.output.display())));
     }
     // Before any work: a missing directory or a read-only file would otherwise be found after the render.
     let target = mislab::io::output_file::check(&args.output, args.force).map_err(bad)?;
-    if ext.as_deref() == Some("exr") && settings.exposure != 0.0 {
+    if ext.as_deref() == Some("exr") && args.flags.settings.exposure != 0.0 {
         eprintln!("note: --exposure is ignored for EXR output (linear radiance); it applies to PNG and the viewer");
     }
-    let budget = match (args.spp, args.time) {
-        (Some(0), _) => return Err(bad("--spp must be at least 1")),
-        (Some(n), _) => {
-            // Hammersley and stratified build their points for a fixed count: refuse or round with a message.
-            let used = mislab::render::samplers::check_spp(settings.sampler, n).map_err(bad)?;
-            let note = mislab::render::samplers::spp_message(settings.sampler, n, used);
-            if !note.is_empty() {
-                eprintln!("note: {note}");
-            }
-            Budget::Samples(used)
-        }
-        (None, Some(t)) if t.is_finite() && t > 0.0 => Budget::Time(Duration::from_secs_f64(t)),
-        (None, Some(t)) => return Err(bad(format!("--time {t} must be a positive number of seconds"))),
-        (None, None) => Budget::Samples(64),
-    };
-    // State flags and the state to resume first: a bad state file fails before any scene or device work.
-    let mut session = mislab::state::session::Session::open(&args.state, args.spp, &args.output).map_err(bad)?;
+    // The flags and the state to resume first: a bad state file fails before any scene or device work.
+    let mut job = api::Job::new(&args.flags, Some(&args.output)).map_err(|e| bad(e.to_string()))?;
+    for note in &job.notes {
+        eprintln!("note: {note}");
+    }
     let t_start = Instant::now();
     // Catch Ctrl-C (and SIGTERM, SIGHUP: the ctrlc crate's `termination` feature) from the start: during
     // start-up it stops before rendering, afterwards it writes what has accumulated.
@@ -222,102 +198,54 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         })
     };
     // The scene first: a bad file is reported without waiting for (or needing) a device.
-    let scene = load_scene(&args.scene)?;
+    let scene = api::SceneHandle::load(&args.scene).map_err(|e| bad(e.to_string()))?;
     if let Some(code) = startup_interrupted() {
         return Ok(code);
-    }
-    // A pbrt Film / Mitsuba hdrfilm size is the default: used when --width and --height are both left at theirs.
-    let default = Settings::default();
-    if let (Some([w, h]), true) =
-        (scene.film_size, settings.width == default.width && settings.height == default.height)
-    {
-        eprintln!("note: image size {w}x{h} from the scene file (--width/--height override it)");
-        (settings.width, settings.height) = (w, h);
     }
     let t_loaded = Instant::now();
-    let ctx = gpu_context()?;
+    let lab = api::Lab::open().map_err(|e| bad(e.to_string()))?;
     if let Some(code) = startup_interrupted() {
         return Ok(code);
     }
-    eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
+    eprintln!("adapter: {}", lab.adapter());
+    eprintln!("scene: {}", scene.summary());
     let t_device = Instant::now();
-    let data = SceneData::build(&scene);
-    eprintln!(
-        "scene: {} — {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights; BVH {} nodes built in {:.1} ms, {:.1} MiB{}",
-        scene.name,
-        scene.triangle_count(),
-        scene.spheres.len(),
-        scene.quads.len(),
-        scene.materials.len(),
-        scene.textures.len(),
-        data.selectable_lights(),
-        data.bvh_node_count(),
-        data.bvh_seconds * 1e3,
-        data.bvh_bytes() as f64 / (1 << 20) as f64,
-        // Per triangle only where there are triangles (the BVH also holds spheres and quads).
-        match scene.triangle_count() {
-            0 => String::new(),
-            n => format!(" ({:.0} B/triangle)", data.bvh_bytes() as f64 / n as f64),
-        },
-    );
-    if let Some(w) = mislab::render::reachability::unreachable_light_warning(&data, &settings) {
-        eprintln!("warning: {w}");
-    }
-    let scene_hash = mislab::state::scene_hash(&data, &scene.camera);
-    let gpu_scene = GpuScene::upload(&ctx, data).map_err(|e| bad(format!("{}: {e}", args.scene.scene)))?;
-    let mut renderer = Renderer::new(&ctx, &gpu_scene, scene.camera.clone(), settings.clone()).map_err(bad)?;
-    if let Budget::Samples(n) = budget {
-        renderer.set_sampler_spp(n);
-    }
-    if let (Some(s), Budget::Samples(n)) = (session.as_mut(), budget) {
-        s.start(&mut renderer, &args.scene.scene, scene_hash, &settings, n, n).map_err(bad)?;
-    }
-    ctx.wait().map_err(|e| bad(e.to_string()))?;
-    let t_ready = Instant::now();
-    eprintln!(
-        "start-up: {:.2} s (scene load {:.2} s, device {:.2} s, BVH + upload + shader compilation {:.2} s) — not counted in the render time",
-        (t_ready - t_start).as_secs_f64(),
-        (t_loaded - t_start).as_secs_f64(),
-        (t_device - t_loaded).as_secs_f64(),
-        (t_ready - t_device).as_secs_f64()
-    );
-    if let Some(code) = startup_interrupted() {
-        return Ok(code);
-    }
-    let bar = match budget {
-        Budget::Samples(n) => indicatif::ProgressBar::new(n as u64),
-        Budget::Time(t) => indicatif::ProgressBar::new((t.as_secs_f64() * 1000.0) as u64),
+    let (settings, _) = job.settings_for(&scene);
+    // Hidden until start-up is over (`CliObserver::started`).
+    let length = match job.budget {
+        api::Budget::Samples(n) => n as u64,
+        api::Budget::Time(t) => (t.as_secs_f64() * 1000.0) as u64,
     };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = indicatif::ProgressBar::with_draw_target(Some(length), indicatif::ProgressDrawTarget::hidden());
     let pixels = (settings.width * settings.height) as f64;
-    let progress = |spp: u32, secs: f64| {
-        match budget {
-            Budget::Samples(_) => bar.set_position(spp as u64),
-            Budget::Time(_) => bar.set_position((secs * 1000.0) as u64),
-        }
-        bar.set_message(format!("{spp} spp, {:.2} M samples/s", spp as f64 * pixels / secs.max(1e-9) / 1e6));
+    let mut observer = CliObserver {
+        bar,
+        budget: job.budget,
+        state: job.state_path().is_some(),
+        pixels,
+        interrupt: &interrupt,
+        started: |seconds: f64| {
+            eprintln!(
+                "start-up: {:.2} s (scene load and BVH {:.2} s, device {:.2} s, upload + shader compilation {:.2} s) — not counted in the render time",
+                (t_device - t_start).as_secs_f64() + seconds,
+                (t_loaded - t_start).as_secs_f64(),
+                (t_device - t_loaded).as_secs_f64(),
+                seconds
+            );
+        },
     };
-    let stats = match &session {
-        Some(s) => s.run(&ctx, &mut renderer, &interrupt, progress),
-        None => progressive::run(&ctx, &mut renderer, budget, &interrupt, progress),
-    }
-    .map_err(|e| bad(e.to_string()))?;
-    bar.finish_and_clear();
+    let image = api::render(&lab, &scene, &mut job, &mut observer).map_err(|e| bad(e.to_string()))?;
+    observer.bar.finish_and_clear();
+    let stats = &image.stats;
     if stats.interrupted && stats.spp == 0 {
-        // A signal between start-up's last check and the first whole sample: an empty image would be a lie.
+        // A signal during start-up or before the first whole sample: an empty image would be a lie.
         eprintln!("{STARTUP_INTERRUPTED} (before the first sample per pixel)");
         return Ok(EXIT_INTERRUPTED);
     }
-    if let Some(s) = &session {
-        s.save(&ctx, &renderer, stats.seconds).map_err(bad)?;
-        eprintln!("wrote state {} (samples {}..{})", s.path().display(), s.range().0, renderer.samples());
+    if let Some(path) = job.state_path() {
+        eprintln!("wrote state {} (samples {}..{})", path.display(), image.sample_range.0, image.sample_range.1);
     }
-    let film = renderer.film(&ctx).map_err(|e| bad(e.to_string()))?;
-    let attributes = mislab::lab::reference::header_attributes(&args.scene, &settings, &stats);
-    film.save_to(&target, settings.exposure, args.tonemap, &attributes).map_err(bad)?;
+    image.save_to(&target, args.tonemap).map_err(|e| bad(e.to_string()))?;
     let extra = if stats.extra_rows > 0 {
         format!(" (and one more in {} of {} rows)", stats.extra_rows, settings.height)
     } else {
@@ -332,7 +260,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
         stats.nonfinite
     );
-    if let Some((guided, slots)) = renderer.guide_coverage() {
+    if let Some((guided, slots)) = image.guide_coverage {
         eprintln!("environment guide: {guided} of {slots} slots (region × normal) draw sky samples from it");
     }
     if stats.interrupted {
@@ -345,6 +273,39 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     }
     eprintln!("wrote {}", args.output.display());
     Ok(0)
+}
+
+/// The render command's observer: a progress bar (shown once sampling starts), the start-up line, and Ctrl-C.
+struct CliObserver<'a, S: FnMut(f64)> {
+    bar: indicatif::ProgressBar,
+    budget: api::Budget,
+    /// A state render counts its bar in sample indices (a resumed render starts where it stopped).
+    state: bool,
+    pixels: f64,
+    interrupt: &'a AtomicBool,
+    started: S,
+}
+
+impl<S: FnMut(f64)> api::Observer for CliObserver<'_, S> {
+    fn started(&mut self, seconds: f64) {
+        (self.started)(seconds);
+        self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        self.bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+    }
+    fn progress(&mut self, p: &api::Progress) {
+        match self.budget {
+            api::Budget::Samples(_) => self.bar.set_position(if self.state { p.sample_index } else { p.spp } as u64),
+            api::Budget::Time(_) => self.bar.set_position((p.seconds * 1000.0) as u64),
+        }
+        let rate = p.spp as f64 * self.pixels / p.seconds.max(1e-9) / 1e6;
+        self.bar.set_message(format!("{} spp, {rate:.2} M samples/s", p.spp));
+    }
+    fn stop_requested(&mut self) -> bool {
+        self.interrupt.load(Ordering::SeqCst)
+    }
 }
 
 fn info(scene_name: Option<String>) -> Result<u8, Failure> {

@@ -687,8 +687,7 @@ fn reference_exr_records_spp_and_settings() {
     let ctx = gpu();
     let scene = scene("veach-mis");
     let settings = reference_settings(&small(24, 16));
-    let (film, stats) =
-        render_reference(&ctx, &scene, &settings, mislab::render::progressive::Budget::Samples(40), 0).unwrap();
+    let (film, stats) = render_reference(&ctx, &scene, &settings, mislab::api::Budget::Samples(40), 0).unwrap();
     assert_eq!(stats.spp, 40);
     assert_eq!(film.spp(), 40);
     let dir = scratch("reference");

@@ -1,11 +1,10 @@
 //! What the benchmarks share: the device, the bench scenes (built-ins and DamagedHelmet under an HDR from
 //! ../shared/testdata) and their environment variables.
 
+use mislab::api::{self, Budget, RenderStats};
 use mislab::gpu::GpuContext;
-use mislab::render::progressive::{self, Budget, RenderStats};
 use mislab::render::Renderer;
 use mislab::scene::{self, envmap, Environment, LoadOptions, Scene};
-use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -38,6 +37,6 @@ pub fn load(label: &str) -> Scene {
 
 /// Renders progressively for `seconds` (pipelines already built), as `mislab render --time` does.
 pub fn render_for(ctx: &GpuContext, r: &mut Renderer, seconds: f64) -> RenderStats {
-    progressive::run(ctx, r, Budget::Time(Duration::from_secs_f64(seconds)), &AtomicBool::new(false), |_, _| {})
+    api::drive(ctx, r, api::Plan::of(Budget::Time(Duration::from_secs_f64(seconds))), &mut api::Unobserved)
         .expect("render")
 }

@@ -2,11 +2,12 @@
 //! written as linear EXR whose header records the sample count, the render time, the scene and every setting
 //! (custom attributes); and reading such references back for `mislab bench`.
 
+pub use crate::api::header_attributes;
+use crate::api::{Budget, RenderStats};
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
 pub use crate::io::exr_image::ReferenceImage;
 use crate::render::film::Film;
-use crate::render::progressive::{Budget, RenderStats};
 use crate::render::settings::*;
 use crate::render::Renderer;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
@@ -177,25 +178,6 @@ pub fn render_reference_from(
         eprintln!("reference: lavapipe's loop budget dropped samples; retrying with {dispatch} spp per dispatch");
     }
     Err("pixels miss samples even with 1 spp per dispatch".into())
-}
-
-/// The custom header attributes of a reference: spp, seconds, scene, settings (JSON), software.
-pub fn header_attributes(scene: &SceneSpec, settings: &Settings, stats: &RenderStats) -> Vec<(String, String)> {
-    vec![
-        ("spp".into(), stats.spp.to_string()),
-        // Rows of a time-budgeted render whose pixels hold one sample more (its last, partial pass).
-        ("extraSampleRows".into(), stats.extra_rows.to_string()),
-        ("renderSeconds".into(), format!("{:.3}", stats.seconds)),
-        ("nonfiniteSamples".into(), stats.nonfinite.to_string()),
-        ("seed".into(), settings.seed.to_string()),
-        ("interrupted".into(), stats.interrupted.to_string()),
-        ("scene".into(), scene.scene.clone()),
-        ("environment".into(), scene.env.as_ref().map(|p| p.display().to_string()).unwrap_or_default()),
-        ("envScale".into(), scene.env_scale.to_string()),
-        ("envRotation".into(), scene.env_rotation.to_string()),
-        ("mislabSettings".into(), serde_json::to_string(settings).unwrap_or_default()),
-        ("mislabVersion".into(), env!("CARGO_PKG_VERSION").to_string()),
-    ]
 }
 
 /// Writes `film` as linear float EXR with `attributes` (see `header_attributes`) as text attributes.

@@ -1,7 +1,7 @@
 //! The renderer: a scene flattened and uploaded (`scene_data`, `gpu_scene`, `lights`) through one binding table
 //! (`bindings`), the shaders composed (`shaders`) and specialised by settings and scene features (`settings`,
 //! `features`, `baked`, `pipeline_cache`), the `Renderer` that owns the accumulation and is advanced one way
-//! (`renderer`, `progressive`), and the film it produces.
+//! (`renderer`; `api::drive` drives it to a budget), and the film it produces.
 
 pub mod baked;
 pub mod bindings;
@@ -13,7 +13,6 @@ pub mod gpu_scene;
 pub mod light_table;
 pub mod lights;
 pub mod pipeline_cache;
-pub mod progressive;
 pub mod reachability;
 pub mod render_module;
 pub mod renderer;

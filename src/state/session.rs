@@ -4,12 +4,10 @@
 use super::{RenderState, StateHeader};
 use crate::gpu::types::GpuAccum;
 use crate::gpu::GpuContext;
-use crate::render::progressive::{RenderStats, TARGET_SUBMIT_SECONDS};
 use crate::render::settings::Settings;
 use crate::render::Renderer;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// `mislab render` flags for state files, checkpoints and parts.
 #[derive(clap::Args, Clone, Debug, Default)]
@@ -67,8 +65,9 @@ pub struct Session {
 
 impl Session {
     /// Checks the flags and reads the state to resume (before any scene or device work, so a bad state file
-    /// fails fast). `spp` is the render's --spp, `output` its image.
-    pub fn open(args: &StateArgs, spp: Option<u32>, output: &Path) -> Result<Option<Session>, String> {
+    /// fails fast). `spp` is the render's --spp, `output` its image (whose name with `.state` is the default
+    /// state file; without one, --state or --resume must name the file).
+    pub fn open(args: &StateArgs, spp: Option<u32>, output: Option<&Path>) -> Result<Option<Session>, String> {
         if !args.active() {
             return Ok(None);
         }
@@ -81,7 +80,13 @@ impl Session {
             Some(t) => return Err(format!("--checkpoint-every {t} must be a positive number of seconds")),
         };
         let resumed = args.resume.as_deref().map(RenderState::read).transpose()?;
-        let path = args.state.clone().or_else(|| args.resume.clone()).unwrap_or_else(|| output.with_extension("state"));
+        let path = match (args.state.clone().or_else(|| args.resume.clone()), output) {
+            (Some(path), _) => path,
+            (None, Some(output)) => output.with_extension("state"),
+            (None, None) => {
+                return Err("--part and --checkpoint-every need --state FILE (the state file to write)".into())
+            }
+        };
         Ok(Some(Session { path, every, part: args.part, resumed, header: None, seconds_before: 0.0 }))
     }
 
@@ -167,6 +172,11 @@ impl Session {
         self.path.display().to_string()
     }
 
+    /// How often to checkpoint, if at all.
+    pub fn every(&self) -> Option<Duration> {
+        self.every
+    }
+
     /// Sample indices `[start, end)` of this run's file.
     pub fn range(&self) -> (u32, u32) {
         self.header.as_ref().map_or((0, 0), |h| h.range)
@@ -184,47 +194,5 @@ impl Session {
             ..header.clone()
         };
         RenderState::from_film(header, &film).write(&self.path)
-    }
-
-    /// Renders the rest of the range in submissions of about a second (shorter with a shorter checkpoint
-    /// interval), checkpointing when due, until done or `interrupt`. `progress(next_sample_index, seconds)`.
-    pub fn run(
-        &self,
-        ctx: &GpuContext,
-        renderer: &mut Renderer,
-        interrupt: &AtomicBool,
-        mut progress: impl FnMut(u32, f64),
-    ) -> Result<RenderStats, String> {
-        let end = self.range().1;
-        let start = Instant::now();
-        let (first, rays_first) = (renderer.samples(), renderer.rays_total());
-        let mut last_checkpoint = Instant::now();
-        let target = self.every.map_or(TARGET_SUBMIT_SECONDS, |e| e.as_secs_f64().min(TARGET_SUBMIT_SECONDS));
-        let mut batch = 1u32;
-        let mut interrupted = false;
-        while renderer.samples() < end {
-            if interrupt.load(Ordering::SeqCst) {
-                interrupted = true;
-                break;
-            }
-            let n = batch.min(end - renderer.samples());
-            let t0 = Instant::now();
-            renderer.render(ctx, n)?;
-            let dt = t0.elapsed().as_secs_f64();
-            progress(renderer.samples(), start.elapsed().as_secs_f64());
-            if self.every.is_some_and(|e| last_checkpoint.elapsed() >= e) && renderer.samples() < end {
-                self.save(ctx, renderer, start.elapsed().as_secs_f64())?;
-                last_checkpoint = Instant::now();
-            }
-            batch = ((target / (dt / n as f64).max(1e-9)) as u32).clamp(1, 4096);
-        }
-        Ok(RenderStats {
-            spp: renderer.samples() - first,
-            extra_rows: 0,
-            seconds: start.elapsed().as_secs_f64(),
-            rays: renderer.rays_total() - rays_first,
-            nonfinite: renderer.nonfinite_total(),
-            interrupted,
-        })
     }
 }

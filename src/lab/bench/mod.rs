@@ -21,7 +21,8 @@ pub use args::BenchArgs;
 pub use group::{BenchFile, BenchGroup};
 use output::write_outputs;
 use results::summarize;
-pub use results::{to_csv, BenchRow, ConfigSummary};
+pub use results::{to_csv, BenchRow, ConfigSummary, CSV_COLUMNS};
+pub use runner::run_configurations;
 use runner::{run_group, slug, GroupResult};
 pub use suite::lecture_suite;
 

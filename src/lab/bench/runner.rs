@@ -96,7 +96,7 @@ fn group_reference(
         ctx,
         scene,
         &settings,
-        crate::render::progressive::Budget::Samples(g.reference_spp),
+        crate::api::Budget::Samples(g.reference_spp),
         g.dispatch_spp,
     )?;
     eprintln!("reference: {} spp in {:.1} s", stats.spp, t.elapsed().as_secs_f64());
@@ -116,8 +116,29 @@ pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result
         _ => g,
     };
     let (reference, ref_name, reference_spp) = group_reference(ctx, g, &scene, refs)?;
+    let (rows, heatmaps) = run_configurations(ctx, g, &scene, &reference)?;
+    Ok(GroupResult { group: g.clone(), rows, heatmaps, reference: ref_name, reference_spp })
+}
+
+/// Every configuration of group `g` (its film size already resolved) over the ladder and the seeds, measured
+/// against `reference`: the rows, and per configuration the mean per-pixel relMSE at the last point.
+#[allow(clippy::type_complexity)]
+pub fn run_configurations(
+    ctx: &GpuContext,
+    g: &BenchGroup,
+    scene: &crate::scene::Scene,
+    reference: &[[f32; 3]],
+) -> Result<(Vec<BenchRow>, Vec<(String, Vec<f64>)>), String> {
+    if reference.len() != (g.width * g.height) as usize {
+        return Err(format!(
+            "the reference has {} pixels, the benchmark renders {}x{}",
+            reference.len(),
+            g.width,
+            g.height
+        ));
+    }
     let configs = g.configurations();
-    let data = SceneData::build(&scene);
+    let data = SceneData::build(scene);
     let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", g.scene))?;
     let mut renderer: Option<Renderer> = None;
     let mut rows = vec![];
@@ -149,7 +170,7 @@ pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result
             let mut attempt = 0;
             let seed_rows = loop {
                 r.set_dispatch_spp(Some(dispatch_spp));
-                match run_seed(ctx, r, &mut timer, g, settings, seed, &reference) {
+                match run_seed(ctx, r, &mut timer, g, settings, seed, reference) {
                     Ok(v) => break v,
                     Err(SeedError::Incomplete(spp)) if dispatch_spp > 1 && attempt < 8 => {
                         dispatch_spp /= 2;
@@ -222,7 +243,7 @@ pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result
             heatmaps.push((label, h));
         }
     }
-    Ok(GroupResult { group: g.clone(), rows, heatmaps, reference: ref_name, reference_spp })
+    Ok((rows, heatmaps))
 }
 
 struct Point {

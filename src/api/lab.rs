@@ -1,0 +1,37 @@
+//! The lab: a device opened once, whose compiled pipelines every render through it reuses (building one takes
+//! seconds on lavapipe; a second render of the same scene and settings starts sampling at once).
+
+use super::error::ApiError;
+use crate::gpu::GpuContext;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// An open device and what it has compiled. Open one per process and render everything through it.
+pub struct Lab {
+    ctx: GpuContext,
+    /// Tells labs apart, for the scenes uploaded to each (`SceneHandle::upload`).
+    pub(crate) id: u64,
+}
+
+impl Lab {
+    /// Opens the chosen Vulkan adapter (`WGPU_ADAPTER_NAME` picks one by name; lavapipe serves where no GPU is).
+    pub fn open() -> Result<Lab, ApiError> {
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        let ctx = GpuContext::new().map_err(|e| ApiError::Device(e.to_string()))?;
+        Ok(Lab { ctx, id: NEXT.fetch_add(1, Ordering::Relaxed) })
+    }
+
+    /// The device, for the lab's own tools (stress cases, probes) that work below scenes and images.
+    pub fn gpu(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    /// The adapter's name and type, as `mislab info` prints them.
+    pub fn adapter(&self) -> String {
+        format!("{} ({:?})", self.ctx.info.name, self.ctx.info.device_type)
+    }
+
+    /// Render pipelines compiled so far (shared by every render through this lab).
+    pub fn pipelines_compiled(&self) -> usize {
+        self.ctx.pipelines.len()
+    }
+}

@@ -1,0 +1,94 @@
+//! The embeddable API (`mislab::api`): one loop for every budget, observers that watch and stop, a render in steps
+//! equal to one render, and flags named once for every front end.
+
+use mislab::api::{self, Budget, Job, Lab, Observer, Progress, RenderFlags, SceneHandle};
+
+fn lab() -> Lab {
+    Lab::open().expect("no GPU adapter (install Mesa's lavapipe: apt-get install mesa-vulkan-drivers)")
+}
+
+fn job(pairs: &[(&str, &str)]) -> Job {
+    Job::from_pairs(pairs).expect("flags")
+}
+
+const SMALL: [(&str, &str); 3] = [("width", "40"), ("height", "24"), ("seed", "4")];
+
+#[test]
+fn flags_parse_like_the_command_line_and_name_what_is_wrong() {
+    let f = RenderFlags::from_pairs(&[("spp", "12"), ("light_sampling", "area"), ("part", "1/3")]).unwrap();
+    assert_eq!(f.spp, Some(12));
+    assert_eq!(f.settings.light_sampling.name(), "area");
+    assert_eq!(f.state.part, Some((1, 3)));
+    let e = RenderFlags::from_pairs(&[("no_such_flag", "1")]).unwrap_err().to_string();
+    assert!(e.contains("--no-such-flag"), "{e}");
+    let e = RenderFlags::from_pairs(&[("strategy", "bogus")]).unwrap_err().to_string();
+    assert!(e.contains("bogus") && e.contains("mis"), "{e}");
+    assert!(matches!(Job::from_pairs(&[("spp", "0")]), Err(api::ApiError::Settings(_))));
+    // --part without a state file to write: Python has no output name to derive one from.
+    assert!(matches!(Job::from_pairs(&[("spp", "4"), ("part", "0/2")]), Err(api::ApiError::State(_))));
+    let every = RenderFlags::describe();
+    let strategy = every.iter().find(|f| f.name == "strategy").unwrap();
+    assert!(strategy.choices.contains(&"mis".to_string()) && strategy.default.as_deref() == Some("mis"));
+}
+
+#[test]
+fn a_missing_scene_is_not_found_and_a_bad_one_a_scene_error() {
+    let e = SceneHandle::named("no-such-dir/none.gltf").err().unwrap();
+    assert!(matches!(e, api::ApiError::NotFound(_)), "{e}");
+    let dir = std::env::temp_dir().join(format!("mislab-api-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.pbrt");
+    std::fs::write(&bad, "WorldBegin\nFrobnicate 1\n").unwrap();
+    let e = SceneHandle::named(bad.to_str().unwrap()).err().unwrap();
+    assert!(matches!(e, api::ApiError::Scene(_)) && e.to_string().contains("bad.pbrt: line 2"), "{e}");
+}
+
+/// Counts progress calls and stops after `stop_after` of them.
+struct StopAfter {
+    calls: u32,
+    stop_after: u32,
+    last: Progress,
+}
+
+impl Observer for StopAfter {
+    fn progress(&mut self, p: &Progress) {
+        self.calls += 1;
+        self.last = *p;
+    }
+    fn stop_requested(&mut self) -> bool {
+        self.calls >= self.stop_after
+    }
+}
+
+#[test]
+fn an_observer_sees_progress_and_stops_the_render_with_what_it_has() {
+    let lab = lab();
+    let scene = SceneHandle::named("veach-mis").unwrap();
+    let mut j = job(&[("time", "600"), SMALL[0], SMALL[1], SMALL[2]]);
+    j.submit_seconds = 0.01;
+    let mut watch = StopAfter { calls: 0, stop_after: 3, last: Progress::default() };
+    let img = api::render(&lab, &scene, &mut j, &mut watch).unwrap();
+    assert!(img.stats.interrupted && watch.calls == 3);
+    assert_eq!(img.spp(), watch.last.spp);
+    assert!(img.spp() >= 3 && img.film.count.iter().all(|&c| c == img.spp()));
+    assert!(img.stats.rays > 0 && img.stats.seconds > 0.0);
+}
+
+#[test]
+fn a_render_in_steps_is_the_render_at_once_bit_for_bit_and_pipelines_are_kept() {
+    let lab = lab();
+    let scene = SceneHandle::named("veach-mis").unwrap();
+    let flags = [("spp", "6"), ("mode", "path"), ("sampler", "sobol"), SMALL[0], SMALL[1], SMALL[2]];
+    let whole = api::render(&lab, &scene, &mut job(&flags), &mut api::Unobserved).unwrap();
+    let compiled = lab.pipelines_compiled();
+    let mut j = job(&flags);
+    let mut r = api::Render::begin(&lab, &scene, &mut j, &mut api::Unobserved).unwrap();
+    for n in [1, 2, 3] {
+        r.advance(&lab, api::Plan::of(Budget::Samples(n)), &mut api::Unobserved).unwrap();
+    }
+    let steps = r.image(&lab).unwrap();
+    assert_eq!(steps.spp(), 6);
+    assert_eq!(lab.pipelines_compiled(), compiled, "the same settings compile nothing new");
+    let bits = |i: &api::Image| i.mean().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&whole), bits(&steps));
+}
