@@ -1,10 +1,8 @@
 //! The `mislab` command line: render, info (and the subcommands later issues add).
 
 use clap::{Args, Parser, Subcommand};
+use mislab::api::SceneSpec;
 use mislab::api::{self, Tonemap};
-use mislab::gpu::{self, GpuContext};
-use mislab::render::scene_data::SceneData;
-use mislab::scene::{self, Environment, SceneSpec};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -131,20 +129,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn gpu_context() -> Result<GpuContext, Failure> {
-    GpuContext::new().map_err(|e| bad(e.to_string()))
-}
-
-/// Loads the scene named on the command line (see `SceneSpec::load`).
-fn load_scene(spec: &SceneSpec) -> Result<scene::Scene, Failure> {
-    spec.load().map_err(bad)
-}
-
 fn stress(filter: Option<&str>) -> Result<u8, Failure> {
-    let ctx = gpu_context()?;
-    eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
-    let outcomes = mislab::lab::stress::run(&ctx, filter, |o| eprintln!("{}", mislab::lab::stress::progress_line(o)))
-        .map_err(bad)?;
+    let lab = api::Lab::open().map_err(|e| bad(e.to_string()))?;
+    eprintln!("adapter: {}", lab.adapter());
+    let outcomes =
+        mislab::lab::stress::run(lab.gpu(), filter, |o| eprintln!("{}", mislab::lab::stress::progress_line(o)))
+            .map_err(bad)?;
     if outcomes.is_empty() {
         return Err(bad(format!("--filter '{}' matches no stress case", filter.unwrap_or_default())));
     }
@@ -309,84 +299,17 @@ impl<S: FnMut(f64)> api::Observer for CliObserver<'_, S> {
 }
 
 fn info(scene_name: Option<String>) -> Result<u8, Failure> {
-    let adapters = gpu::list_adapters();
     println!("Vulkan adapters:");
-    for a in &adapters {
-        println!("  {} ({:?}, {})", a.name, a.device_type, a.driver);
+    for a in api::adapters() {
+        println!("  {a}");
     }
-    let ctx = gpu_context()?;
-    print!("chosen {}", gpu::describe(&ctx));
+    let lab = api::Lab::open().map_err(|e| bad(e.to_string()))?;
+    print!("chosen {}", lab.describe());
     if let Some(name) = scene_name {
-        let scene = load_scene(&SceneSpec::named(&name))?;
-        let data = SceneData::build(&scene);
-        for line in &scene.import_report {
+        let scene = api::SceneHandle::named(&name).map_err(|e| bad(e.to_string()))?;
+        for line in scene.report(&lab) {
             println!("{line}");
         }
-        println!(
-            "scene {}: {} triangles, {} spheres, {} quads, {} materials, {} textures, {} lights ({} delta), environment: {}",
-            scene.name,
-            scene.triangle_count(),
-            scene.spheres.len(),
-            scene.quads.len(),
-            scene.materials.len(),
-            scene.textures.len(),
-            data.selectable_lights(),
-            data.delta_lights,
-            match &scene.environment {
-                Environment::None => "none".to_string(),
-                Environment::Constant(c) => format!("constant {c}"),
-                Environment::Map { map, .. } => format!("map {} ({}x{})", map.path.display(), map.width, map.height),
-            }
-        );
-        let lamps = data.convex_lamps();
-        if lamps > 0 {
-            println!(
-                "convex lamps: {lamps}, {} faces in all; each is one light, sampled through the cone of a sphere inside it",
-                data.lamp_faces
-            );
-        }
-        let boxed: Vec<_> = data.lights.iter().filter(|l| l.shadow_box == 1).collect();
-        if !boxed.is_empty() {
-            let mut meshes: Vec<[u32; 6]> = boxed
-                .iter()
-                .map(|l| {
-                    let [a, b, c] = l.position.map(f32::to_bits);
-                    let [d, e, f] = l.direction.map(f32::to_bits);
-                    [a, b, c, d, e, f]
-                })
-                .collect();
-            meshes.sort_unstable();
-            meshes.dedup();
-            println!(
-                "isolated emitters: {} triangle lights in {} meshes; shadow rays towards them stop at the mesh's box",
-                boxed.len() - lamps,
-                meshes.len()
-            );
-        }
-        println!(
-            "BVH: {} nodes, {:.1} ms, SAH cost {:.2}, {} bytes",
-            data.bvh_node_count(),
-            data.bvh_seconds * 1e3,
-            data.bvh_sah,
-            data.bvh_bytes()
-        );
-        let m = mislab::render::gpu_scene::memory_per_triangle(&data);
-        let every = mislab::render::gpu_scene::binding_sizes(&data).iter().sum::<u64>();
-        println!(
-            "memory per triangle: BVH {:.0} B, geometry {:.0} B, shading {:.0} B, total {:.0} B; every scene buffer {:.1} MiB",
-            m.bvh,
-            m.geometry,
-            m.shading,
-            m.total(),
-            every as f64 / (1u64 << 20) as f64
-        );
-        // What the upload does on this device: texels or vertices past one binding take a second, or it refuses.
-        let mut uploaded = data.clone();
-        if let Err(e) = mislab::render::gpu_scene::fit_to_binding_limit(&mut uploaded, ctx.max_storage_binding()) {
-            println!("upload: {e}");
-        }
-        let features = mislab::render::features::Features::of(&uploaded);
-        println!("features (code paths compiled into its specialised pipelines): {}", features.describe());
     }
     Ok(0)
 }

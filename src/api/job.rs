@@ -22,6 +22,8 @@ pub struct Job {
     pub verify_complete: bool,
     /// Seconds a submission should take (the observer is asked between submissions).
     pub submit_seconds: f64,
+    /// Samples per pixel in one dispatch instead of the renderer's safe default for the mode.
+    pub dispatch_spp: Option<u32>,
     pub(crate) session: Option<Session>,
 }
 
@@ -38,7 +40,22 @@ impl Job {
             notes: note.into_iter().collect(),
             verify_complete: false,
             submit_seconds: super::drive::TARGET_SUBMIT_SECONDS,
+            dispatch_spp: None,
             session,
+        })
+    }
+
+    /// A job of `settings` to `budget`, with no state file (the lab's tools, which choose settings themselves).
+    pub fn of(settings: Settings, budget: Budget) -> Result<Job, ApiError> {
+        settings.validate().map_err(ApiError::Settings)?;
+        Ok(Job {
+            settings,
+            budget,
+            notes: vec![],
+            verify_complete: false,
+            submit_seconds: super::drive::TARGET_SUBMIT_SECONDS,
+            dispatch_spp: None,
+            session: None,
         })
     }
 

@@ -20,6 +20,12 @@ impl Lab {
         Ok(Lab { ctx, id: NEXT.fetch_add(1, Ordering::Relaxed) })
     }
 
+    /// A lab on a device opened elsewhere (the lab's tools that hold a `GpuContext`): the same device and pipelines.
+    pub fn on(ctx: &GpuContext) -> Lab {
+        static NEXT: AtomicU64 = AtomicU64::new(1 << 32);
+        Lab { ctx: ctx.clone(), id: NEXT.fetch_add(1, Ordering::Relaxed) }
+    }
+
     /// The device, for the lab's own tools (stress cases, probes) that work below scenes and images.
     pub fn gpu(&self) -> &GpuContext {
         &self.ctx

@@ -23,6 +23,7 @@ mod lab;
 mod merge;
 mod observer;
 mod render;
+mod report;
 mod scene;
 
 pub use budget::{Budget, RenderStats};
@@ -35,6 +36,7 @@ pub use lab::Lab;
 pub use merge::merge;
 pub use observer::{Callbacks, Observer, Progress, Unobserved};
 pub use render::{render, Render};
+pub use report::adapters;
 pub use scene::SceneHandle;
 // The types a front end hands to the API or gets from it.
 pub use crate::render::film::{Film, Tonemap};

@@ -23,7 +23,7 @@ pub fn render(lab: &Lab, scene: &SceneHandle, job: &mut Job, observer: &mut dyn 
         Some(s) => Budget::Samples(s.range().1.saturating_sub(r.renderer.samples())),
         None => job.budget,
     };
-    let mut dispatch = r.renderer.max_dispatch_spp();
+    let mut dispatch = job.dispatch_spp.unwrap_or_else(|| r.renderer.max_dispatch_spp());
     loop {
         let mut save = |renderer: &Renderer, seconds: f64| match &job.session {
             Some(s) => s.save(lab.gpu(), renderer, seconds).map_err(ApiError::State),
@@ -90,6 +90,7 @@ impl Render {
         if let Budget::Samples(n) = job.budget {
             renderer.set_sampler_spp(n);
         }
+        renderer.set_dispatch_spp(job.dispatch_spp);
         if let (Some(s), Budget::Samples(n)) = (job.session.as_mut(), job.budget) {
             s.start(&mut renderer, &scene.spec().scene, scene.hash().to_string(), &settings, n, n)
                 .map_err(ApiError::State)?;

@@ -36,6 +36,13 @@ impl SceneHandle {
         Ok(SceneHandle { spec: spec.clone(), scene, data, hash, uploaded: Mutex::new(None) })
     }
 
+    /// A scene loaded elsewhere (the lab's tools that build scenes of their own), named by `spec`.
+    pub fn from_scene(spec: SceneSpec, scene: Scene) -> SceneHandle {
+        let data = SceneData::build(&scene);
+        let hash = crate::state::scene_hash(&data, &scene.camera);
+        SceneHandle { spec, scene, data, hash, uploaded: Mutex::new(None) }
+    }
+
     /// A built-in scene or file by name, with no overrides.
     pub fn named(name: &str) -> Result<SceneHandle, ApiError> {
         SceneHandle::load(&SceneSpec::named(name))

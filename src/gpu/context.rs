@@ -78,7 +78,8 @@ pub struct AdapterSummary {
     pub driver: String,
 }
 
-/// Adapter, device and queue, plus what was learned about them.
+/// Adapter, device and queue, plus what was learned about them. A clone is another handle to the same device.
+#[derive(Clone)]
 pub struct GpuContext {
     /// The instance the adapter came from (kept alive for surfaces).
     pub instance: wgpu::Instance,

@@ -11,12 +11,9 @@
 //!   uniform, power, light-tree, RIS and tree-candidate RIS light selection, at equal time (`--time` per panel, default 4 s): which
 //!   light a sample picks decides the noise.
 
-use crate::gpu::GpuContext;
-use crate::render::film::{Film, Tonemap};
+use crate::api;
+use crate::render::film::Tonemap;
 use crate::render::settings::{Heuristic, LightSampling, LightSelect, Settings, Strategy};
-use crate::render::Renderer;
-use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
-use crate::scene::{self, LoadOptions};
 use std::path::PathBuf;
 
 /// `mislab figure WHICH -o OUT.png`: one of the lecture's figures as a labelled PNG.
@@ -152,22 +149,22 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
     let base = Settings { width: args.width, height: args.height, seed: args.seed, ..Settings::default() };
     let (scene_name, columns, panels) = layout(&args.which, &base)?;
     base.validate()?;
-    let ctx = GpuContext::new().map_err(|e| format!("no usable GPU adapter: {e}"))?;
-    let scene = scene::load(scene_name, &LoadOptions::default()).map_err(|e| e.to_string())?;
-    let gpu_scene = GpuScene::upload(&ctx, SceneData::build(&scene)).map_err(|e| format!("{scene_name}: {e}"))?;
-    let mut renderer = Renderer::new_unprepared(&ctx, &gpu_scene, scene.camera.clone(), base.clone())?;
+    let lab = api::Lab::open().map_err(|e| format!("no usable GPU adapter: {e}"))?;
+    let scene = api::SceneHandle::named(scene_name)?;
     let mut images = Vec::new();
     for p in &panels {
-        renderer.set_settings(p.settings.clone())?;
-        let film = match time {
-            Some(t) => render_for(&ctx, &mut renderer, t)?,
-            None => render(&ctx, &mut renderer, spp)?,
+        let budget = match time {
+            Some(t) => api::Budget::Time(std::time::Duration::from_secs_f64(t)),
+            None => api::Budget::Samples(spp),
         };
-        let mut img = film.to_rgb8(p.settings.exposure, Tonemap::Clamp);
+        let mut job = api::Job::of(p.settings.clone(), budget)?;
+        // At equal time, the first pass is timed apart from the pipeline's compilation (start-up is not counted).
+        let image = api::render(&lab, &scene, &mut job, &mut api::Unobserved)?;
+        let mut img = image.film.to_rgb8(p.settings.exposure, Tonemap::Clamp);
         let scale = if args.width >= 192 { 2 } else { 1 };
         draw_label(&mut img, 4, 4, p.label, scale);
         let budget = match time {
-            Some(t) => format!("{t} s: {} spp", renderer.samples()),
+            Some(t) => format!("{t} s: {} spp", image.spp()),
             None => format!("{spp} spp"),
         };
         draw_label(&mut img, 4, 4 + 9 * scale, &budget, scale);
@@ -198,30 +195,6 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
         args.seed
     );
     Ok(())
-}
-
-/// Renders whole samples per pixel until `seconds` of rendering have passed (the first pass is timed apart from
-/// the pipeline's compilation by a one-sample warm-up that is discarded), and reads the film back.
-fn render_for(ctx: &GpuContext, renderer: &mut Renderer, seconds: f64) -> Result<Film, String> {
-    render(ctx, renderer, 1)?;
-    renderer.set_settings(renderer.settings().clone())?;
-    let start = std::time::Instant::now();
-    let mut step = 1;
-    while start.elapsed().as_secs_f64() < seconds {
-        let t = std::time::Instant::now();
-        renderer.render(ctx, step)?;
-        // Batches of about a tenth of the budget: few submissions, little overshoot.
-        if t.elapsed().as_secs_f64() < seconds / 20.0 {
-            step = (step * 2).min(1 << 16);
-        }
-    }
-    renderer.film(ctx).map_err(|e| e.to_string())
-}
-
-/// Renders `spp` samples per pixel and reads the film back.
-fn render(ctx: &GpuContext, renderer: &mut Renderer, spp: u32) -> Result<Film, String> {
-    renderer.render(ctx, spp)?;
-    renderer.film(ctx).map_err(|e| e.to_string())
 }
 
 /// Writes a PNG through a temporary file and a rename (no truncated figure after an interruption); a figure

@@ -3,19 +3,17 @@
 //! (custom attributes); and reading such references back for `mislab bench`.
 
 pub use crate::api::header_attributes;
-use crate::api::{Budget, RenderStats};
-use crate::gpu::timer::GpuTimer;
+use crate::api::{self, Budget, RenderStats};
 use crate::gpu::GpuContext;
 pub use crate::io::exr_image::ReferenceImage;
 use crate::render::film::Film;
 use crate::render::settings::*;
-use crate::render::Renderer;
-use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{Scene, SceneSpec};
+use crate::state::session::StateArgs;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Seed of references (distinct from the seeds 0, 1, … that `mislab bench` measures, so the reference's
 /// error is independent of theirs).
@@ -88,7 +86,8 @@ pub fn reference_settings(base: &Settings) -> Settings {
     }
 }
 
-/// Renders a reference to a budget in small, checked dispatches (see `bench`: lavapipe's loop budget).
+/// Renders a reference of `scene` with `settings` to a budget, every pixel checked to hold every sample (dispatches
+/// halved where a driver dropped some; `dispatch_spp` 0 = the renderer's default for the mode).
 pub fn render_reference(
     ctx: &GpuContext,
     scene: &Scene,
@@ -96,88 +95,13 @@ pub fn render_reference(
     budget: Budget,
     dispatch_spp: u32,
 ) -> Result<(Film, RenderStats), String> {
-    render_reference_from(
-        ctx,
-        SceneData::build(scene),
-        scene,
-        settings,
-        budget,
-        dispatch_spp,
-        0,
-        &AtomicBool::new(false),
-    )
-}
-
-/// `render_reference` of the sample indices from `first` on (`--part`: `state::session::part_range`), with the
-/// scene's data already built; it stops early with what has accumulated (`RenderStats::interrupted`) once `stop`
-/// is set (Ctrl-C, SIGTERM, SIGHUP).
-#[allow(clippy::too_many_arguments)]
-pub fn render_reference_from(
-    ctx: &GpuContext,
-    data: SceneData,
-    scene: &Scene,
-    settings: &Settings,
-    budget: Budget,
-    dispatch_spp: u32,
-    first: u32,
-    stop: &AtomicBool,
-) -> Result<(Film, RenderStats), String> {
-    let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| e.to_string())?;
-    let mut r = Renderer::new(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?;
-    let mut dispatch = if dispatch_spp > 0 { dispatch_spp } else { r.max_dispatch_spp() };
-    let pixels = settings.width as usize * settings.height as usize;
-    for _attempt in 0..8 {
-        r.restore(&vec![crate::gpu::types::GpuAccum::default(); pixels], first, 0, 0)?;
-        r.set_dispatch_spp(Some(dispatch));
-        let mut timer = GpuTimer::new(ctx, 64);
-        let start = Instant::now();
-        let (mut seconds, mut rays) = (0.0, 0u64);
-        // Submissions of about a second, so a time budget is met closely.
-        let mut chunk = dispatch;
-        let mut interrupted = false;
-        loop {
-            if stop.load(Ordering::SeqCst) && r.samples() > first {
-                interrupted = true;
-                break;
-            }
-            let n = match budget {
-                Budget::Samples(total) => chunk.min(total - (r.samples() - first)),
-                Budget::Time(t) => {
-                    if r.samples() > first && start.elapsed() >= t {
-                        0
-                    } else {
-                        chunk
-                    }
-                }
-            };
-            if n == 0 {
-                break;
-            }
-            let t = r.render_timed(ctx, n, timer.as_mut())?;
-            seconds += t.wall;
-            rays += t.rays;
-            if t.wall < 0.5 {
-                chunk = (chunk * 2).min(1 << 16);
-            }
-            if let Budget::Time(limit) = budget {
-                let per = seconds / (r.samples() - first) as f64;
-                let left = limit.saturating_sub(start.elapsed()).as_secs_f64();
-                chunk = chunk.min(((left / per.max(1e-9)).ceil() as u32).max(1));
-            }
-        }
-        let film = r.film(ctx).map_err(|e| e.to_string())?;
-        if film.is_complete(r.samples() - first) {
-            let spp = r.samples() - first;
-            let stats = RenderStats { spp, extra_rows: 0, seconds, rays, nonfinite: r.nonfinite_total(), interrupted };
-            return Ok((film, stats));
-        }
-        if dispatch == 1 {
-            break;
-        }
-        dispatch /= 2;
-        eprintln!("reference: lavapipe's loop budget dropped samples; retrying with {dispatch} spp per dispatch");
-    }
-    Err("pixels miss samples even with 1 spp per dispatch".into())
+    let lab = api::Lab::on(ctx);
+    let handle = api::SceneHandle::from_scene(SceneSpec::named(&scene.name), scene.clone());
+    let mut job = api::Job::of(settings.clone(), budget)?;
+    job.verify_complete = true;
+    job.dispatch_spp = (dispatch_spp > 0).then_some(dispatch_spp);
+    let image = api::render(&lab, &handle, &mut job, &mut api::Unobserved)?;
+    Ok((image.film, image.stats))
 }
 
 /// Writes `film` as linear float EXR with `attributes` (see `header_attributes`) as text attributes.
@@ -214,16 +138,13 @@ pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
     }
     // Before any work: an unwritable output would otherwise be found after the render.
     let target = crate::io::output_file::check(&args.output, args.force)?;
-    let budget = match (args.spp, args.time) {
-        (Some(0), _) => return Err("--spp must be at least 1".into()),
-        (Some(n), _) => Budget::Samples(n),
-        (None, Some(t)) if t.is_finite() && t > 0.0 => Budget::Time(Duration::from_secs_f64(t)),
-        (None, Some(t)) => return Err(format!("--time {t} must be a positive number of seconds")),
-        (None, None) => return Err("give --spp N or --time SECONDS".into()),
-    };
+    if args.spp.is_none() && args.time.is_none() {
+        return Err("give --spp N or --time SECONDS".into());
+    }
     // The scene first: a bad file is reported without waiting for a device, and its Film size is the default.
     let scene = args.scene.load()?;
     let [width, height] = film_size(args.width, args.height, scene.film_size);
+    let scene = Scene { film_size: None, ..scene };
     let base = Settings {
         width,
         height,
@@ -242,40 +163,29 @@ pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
         let flag = stop.clone();
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
-    let ctx = GpuContext::new().map_err(|e| e.to_string())?;
-    eprintln!("adapter: {} ({:?})", ctx.info.name, ctx.info.device_type);
+    // A part or --state writes the render state as `mislab render --part` does (`mislab merge` reads both).
+    let flags = api::RenderFlags {
+        spp: args.spp,
+        time: args.time,
+        settings: settings.clone(),
+        state: StateArgs { state: args.state.clone(), part: args.part, ..StateArgs::default() },
+    };
+    let mut job = api::Job::new(&flags, Some(&args.output))?;
+    job.verify_complete = true;
+    let lab = api::Lab::open()?;
+    eprintln!("adapter: {}", lab.adapter());
     let t = Instant::now();
-    let data = SceneData::build(&scene);
-    let scene_hash = crate::state::scene_hash(&data, &scene.camera);
-    let total = args.spp.unwrap_or(0);
-    let range = args.part.map_or((0, total), |(k, n)| crate::state::session::part_range(k, n, total));
-    let budget = if args.part.is_some() { Budget::Samples(range.1 - range.0) } else { budget };
-    // (Without --part a --time budget has no sample count: the range is unused.)
-    if args.part.is_some() && range.0 == range.1 {
-        return Err(format!("--part of --spp {total} holds no samples (use at most {total} parts)"));
+    let handle = api::SceneHandle::from_scene(args.scene.clone(), scene);
+    let image =
+        api::render(&lab, &handle, &mut job, &mut api::Callbacks { progress: |_: &api::Progress| {}, stop: &stop })?;
+    let stats = &image.stats;
+    if stats.interrupted && stats.spp == 0 {
+        eprintln!("interrupted before the first sample per pixel: no reference was written");
+        return Ok(130);
     }
-    let (film, stats) = render_reference_from(&ctx, data, &scene, &settings, budget, 0, range.0, &stop)?;
-    let attributes = header_attributes(&args.scene, &settings, &stats);
-    film.save_to(&target, 0.0, crate::render::film::Tonemap::Clamp, &attributes)?;
-    if (args.part.is_some() || args.state.is_some()) && !stats.interrupted {
-        let header = crate::state::StateHeader {
-            scene: args.scene.scene.clone(),
-            scene_hash,
-            settings: settings.clone(),
-            seed: settings.seed,
-            spp_total: total,
-            sampler_spp: crate::render::samplers::DEFAULT_SAMPLER_SPP,
-            part: args.part,
-            range,
-            next: range.1,
-            nonfinite_total: stats.nonfinite,
-            rays_total: stats.rays,
-            seconds: stats.seconds,
-            mislab_version: env!("CARGO_PKG_VERSION").to_string(),
-        };
-        let path = args.state.clone().unwrap_or_else(|| args.output.with_extension("state"));
-        crate::state::RenderState::from_film(header, &film).write(&path)?;
-        eprintln!("wrote state {} (samples {}..{})", path.display(), range.0, range.1);
+    image.save_to(&target, crate::render::film::Tonemap::Clamp)?;
+    if let Some(path) = job.state_path() {
+        eprintln!("wrote state {} (samples {}..{})", path.display(), image.sample_range.0, image.sample_range.1);
     }
     let pixels = (settings.width * settings.height) as f64;
     eprintln!(

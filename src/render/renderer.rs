@@ -633,7 +633,7 @@ impl Renderer {
     }
 
     /// Renders one sample more in the next `rows` film rows of a pass (a band, as the viewer records them) and waits:
-    /// a time budget's last, partial pass (`progressive::run`). Returns whether the band completed the pass.
+    /// a time budget's last, partial pass (`api::drive`). Returns whether the band completed the pass.
     pub fn render_rows(&mut self, ctx: &GpuContext, rows: u32) -> Result<bool, RenderError> {
         self.prepare()?;
         if self.warmed != Some(self.key()) {
