@@ -259,7 +259,7 @@ pub enum Presplit<'a> {
 /// Builds the BVH over all primitives. Triangles are given by their three vertices (the same values, and order,
 /// as in the `tri_verts` buffer); excluded primitives (see [`triangle_aabb`], [`sphere_aabb`], [`quad_aabb`]) are
 /// not in the tree and can never be hit. With [`Presplit::Large`], large triangles are referenced in pieces
-/// (`MISLAB_PRESPLIT=0` turns it off for A/B runs): a triangle may then be in several leaves, never twice in one.
+/// (docs/profile-bvh.md, "Large triangles in pieces", has its measurement): a triangle may then be in several leaves, never twice in one.
 /// Panics if a kind has more than 2^30 primitives.
 pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], presplit: Presplit) -> Bvh {
     build_with(tri_verts, spheres, quads, presplit, false)
@@ -290,7 +290,7 @@ fn build_with(
     let mut tris: Vec<Piece> = (0..tri_verts.len())
         .filter_map(|i| triangle_aabb(&tri_verts[i]).map(|bx| Piece { tri: i as u32, bx }))
         .collect();
-    if let (Presplit::Large { keep_whole }, true) = (presplit, presplit_enabled()) {
+    if let Presplit::Large { keep_whole } = presplit {
         let budget = (presplit::BUDGET * tris.len() as f64) as usize;
         let (split, mut kept): (Vec<Piece>, Vec<Piece>) =
             tris.into_iter().partition(|p| !keep_whole.get(p.tri as usize).is_some_and(|&k| k));
@@ -325,12 +325,6 @@ fn build_with(
     let mut bvh = flatten(&tmp, &order, &refs, &boxes);
     bvh.build_seconds = start.elapsed().as_secs_f64();
     bvh
-}
-
-/// Whether large triangles are pre-split ([`crate::accel::presplit`]); `MISLAB_PRESPLIT=0` turns it off for A/B
-/// runs.
-pub fn presplit_enabled() -> bool {
-    std::env::var("MISLAB_PRESPLIT").map_or(true, |v| v != "0")
 }
 
 /// Removes the second and later pieces of one triangle from each leaf (two pieces of a triangle may land in the

@@ -107,8 +107,8 @@ impl Features {
             dielectric: true,
             diffuse_transmission: true,
             many_lights: true,
-            // Not a code path but the layout every scene of this process is built with (SceneData::build).
-            wide_bvh: crate::render::scene_data::bvh_layout_wide(),
+            // Not a code path but the layout every scene is built with (SceneData::build).
+            wide_bvh: true,
             alpha: true,
             flat: None,
             // The generic pipeline tests a scene's occluders in a loop over their buffer slots (baked_geometry.wgsl).

@@ -41,11 +41,9 @@ fn scene_radius(d: &SceneData) -> f64 {
 }
 
 /// Gives the triangle lights of isolated emitter meshes their stop box (`accel::isolated_emitters`): a shadow ray
-/// towards one may end where it enters that box. `MISLAB_SHADOW_BOX=0` turns it off (for A/B runs).
+/// towards one may end where it enters that box (measured in docs/estimators.md, "Shadow rays that stop at an
+/// isolated emitter").
 fn mark_isolated_emitters(tris: &[[Vec3; 3]], d: &SceneData, lights: &mut [GpuLight]) -> Vec<IsolatedEmitter> {
-    if std::env::var("MISLAB_SHADOW_BOX").is_ok_and(|v| v == "0") {
-        return vec![];
-    }
     let light_of = |i: usize| d.tri_shading.get(i).map_or(INVALID, |s| s.light);
     let emitter = |i: usize| {
         let l = light_of(i);
@@ -70,12 +68,6 @@ fn mark_isolated_emitters(tris: &[[Vec3; 3]], d: &SceneData, lights: &mut [GpuLi
         }
     }
     meshes
-}
-
-/// Whether isolated emitter meshes that are closed, convex and round become convex lamps (`accel::convex_lamps`):
-/// `MISLAB_CONVEX_LAMPS=0` keeps their triangles as lights (for A/B runs).
-pub fn convex_lamps_on() -> bool {
-    !std::env::var("MISLAB_CONVEX_LAMPS").is_ok_and(|v| v == "0")
 }
 
 /// Replaces the triangle lights of every convex lamp among `meshes` by one lamp light (appended) and returns the

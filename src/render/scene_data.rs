@@ -125,19 +125,16 @@ pub fn render_origin(scene: &Scene) -> Vec3 {
 }
 
 impl SceneData {
-    /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device. Convex lamps are made unless
-    /// `MISLAB_CONVEX_LAMPS=0` ([`light_table::convex_lamps_on`]) or the scene keeps its emitter triangles.
+    /// Flattens a scene. Pure CPU work; `GpuScene::upload` sends it to a device. Convex lamps are made unless the
+    /// scene keeps its emitter triangles.
     pub fn build(scene: &Scene) -> SceneData {
-        SceneData::build_with(scene, light_table::convex_lamps_on() && !scene.emitter_triangles_kept)
+        SceneData::build_with(scene, !scene.emitter_triangles_kept)
     }
 
     /// `build`, making convex lamps of the emitter meshes that qualify (`accel::convex_lamps`) or keeping every
     /// emissive triangle a light of its own.
     pub fn build_with(scene: &Scene, convex_lamps: bool) -> SceneData {
-        SceneData::build_options(
-            scene,
-            BuildOptions { convex_lamps, baked_occluders: baked_occluders_on(), baked_root: baked_root_on() },
-        )
+        SceneData::build_options(scene, BuildOptions { convex_lamps, baked_occluders: true, baked_root: true })
     }
 
     /// `build` with each choice given (tests and A/B runs compare them on one scene).
@@ -239,11 +236,7 @@ impl SceneData {
         };
         let bvh_tris: Vec<[Vec3; 3]> = in_bvh.iter().map(|&i| tris[i]).collect();
         let presplit = if split.is_some() { bvh::Presplit::Off } else { presplit };
-        let mut bvh = if bvh_layout_wide() {
-            bvh::build_wide(&bvh_tris, &d.spheres, &d.quads, presplit)
-        } else {
-            bvh::build(&bvh_tris, &d.spheres, &d.quads, presplit)
-        };
+        let mut bvh = bvh::build_wide(&bvh_tris, &d.spheres, &d.quads, presplit);
         // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs. The baked
         // occluders follow the BVH's triangles.
         d.triangles = tris.len();
@@ -378,18 +371,6 @@ pub fn occluder_split(emits: &[bool], analytic_prims: usize, alpha: bool, on: bo
         .then_some(occluders)
 }
 
-/// Whether scenes get their few occluders baked into their pipelines where `occluder_split` allows (the default):
-/// `MISLAB_BAKED_OCCLUDERS=0` keeps every primitive in the BVH, for A/B runs.
-pub fn baked_occluders_on() -> bool {
-    std::env::var("MISLAB_BAKED_OCCLUDERS").map_or(true, |v| v != "0")
-}
-
-/// Whether scenes' own pipelines get their BVH root's boxes as literals (`baked::baked_root`; the default):
-/// `MISLAB_BAKED_ROOT=0` reads the root from its buffer like every other node, for A/B runs.
-pub fn baked_root_on() -> bool {
-    std::env::var("MISLAB_BAKED_ROOT").map_or(true, |v| v != "0")
-}
-
 /// The choices `SceneData::build_options` makes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BuildOptions {
@@ -399,12 +380,6 @@ pub struct BuildOptions {
     pub baked_occluders: bool,
     /// Test the wide BVH root's children against literal boxes in the scene's own pipelines (`baked::baked_root`).
     pub baked_root: bool,
-}
-
-/// Whether scenes get the 8-wide compressed BVH (the default) or the BVH2: `MISLAB_BVH=2` selects the BVH2, for
-/// A/B runs and as the fallback to compare against (docs/profile-bvh.md).
-pub fn bvh_layout_wide() -> bool {
-    std::env::var("MISLAB_BVH").map_or(true, |v| v != "2")
 }
 
 fn xform(t: &Option<TextureRef>) -> ([f32; 4], [f32; 4], u32) {

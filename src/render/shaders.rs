@@ -91,19 +91,17 @@ const BVH_VOTE_FALLBACK: &str = "return b; // BVH_VOTE";
 /// (render, viewer, probes) gets the same code:
 /// - with subgroup operations (wgpu's `Features::SUBGROUP`, which `GpuContext` requests where offered) the BVH2
 ///   traversal's vote becomes `subgroupAll`; without them each lane votes alone (a plain while-while loop). The
-///   wide traversal, the default, has no vote. `MISLAB_BVH_VOTE=0` keeps the lone vote (for A/B runs).
+///   wide traversal, the default, has no vote.
 /// - with 64-bit integers (`Features::SHADER_INT64`, requested where offered) each file of 16-byte loads in
 ///   [`bindings::READ_32_BYTES_AT_A_TIME`] gives way to its `_int64` twin, and the bindings it reads are declared
-///   `array<vec4<u64>>`: 32 bytes a load. `MISLAB_INT64=0` keeps the 16-byte loads (for A/B runs).
+///   `array<vec4<u64>>`: 32 bytes a load (docs/profile-bvh.md has the measurement).
 pub fn for_device(source: &str, features: wgpu::Features) -> std::borrow::Cow<'_, str> {
     let mut out = std::borrow::Cow::Borrowed(source);
-    let vote_off = std::env::var("MISLAB_BVH_VOTE").is_ok_and(|v| v == "0");
-    if features.contains(wgpu::Features::SUBGROUP) && source.contains(BVH_VOTE_FALLBACK) && !vote_off {
+    if features.contains(wgpu::Features::SUBGROUP) && source.contains(BVH_VOTE_FALLBACK) {
         // (naga 30 takes subgroup builtins without WGSL's `enable subgroups;`, which it rejects as unimplemented.)
         out = out.replace(BVH_VOTE_FALLBACK, "return subgroupAll(b);").into();
     }
-    let int64_off = std::env::var("MISLAB_INT64").is_ok_and(|v| v == "0");
-    if features.contains(wgpu::Features::SHADER_INT64) && !int64_off {
+    if features.contains(wgpu::Features::SHADER_INT64) {
         out = with_32_byte_loads(&out).map_or(out, Into::into);
     }
     out
