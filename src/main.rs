@@ -1,6 +1,6 @@
 //! The `mislab` command line: render, info (and the subcommands later issues add).
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use mislab::api::SceneSpec;
 use mislab::api::{self, Tonemap};
 use std::path::PathBuf;
@@ -108,9 +108,20 @@ fn bad(message: impl Into<String>) -> Failure {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command.unwrap_or(Command::Render(RenderArgs::default())) {
-        Command::Render(args) => render(args),
+        Command::Render(mut args) => {
+            // Which flags were typed: a resumed render takes the others from its state file.
+            let given = matches.subcommand_matches("render").map_or_else(Vec::new, |m| {
+                m.ids()
+                    .filter(|id| m.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+                    .map(|id| id.as_str().to_string())
+                    .collect()
+            });
+            args.flags.given = Some(given);
+            render(args)
+        }
         Command::Info { scene } => info(scene),
         Command::View(args) => mislab::viewer::run(args).map(|_| 0).map_err(bad),
         Command::Reference(args) => mislab::lab::reference::run(&args).map_err(bad),

@@ -373,3 +373,59 @@ fn reference_parts_merge_to_the_whole_reference() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+// Issue 47: a state path that the image would overwrite, or that cannot hold a file, is refused before rendering;
+// `--resume S` alone takes the sample count and every setting from the state, and a bad state is reported as such.
+#[test]
+fn state_paths_are_checked_and_a_resume_alone_takes_its_settings_from_the_state() {
+    let d = tmp("resume-alone");
+    let refused = |args: &[&str], want: &str| {
+        let (code, t) = run_code(bin().current_dir(&d).args(args));
+        assert_eq!(code, 2, "{args:?}: {t}");
+        assert!(t.contains(want) && !t.contains("start-up") && !t.contains("panicked"), "{args:?}: {t}");
+    };
+    refused(&["render", "--spp", "4", "--state", "x.exr", "-o", "x.exr"], "same file");
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    refused(&["render", "--spp", "4", "--state", "./sub/../x.exr", "-o", "x.exr"], "same file");
+    std::fs::create_dir_all(d.join("dir.state")).unwrap();
+    refused(&["render", "--spp", "4", "--state", "dir.state", "-o", "y.exr"], "is a directory");
+    let fifo = d.join("fifo.state");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    refused(&["render", "--spp", "4", "--state", "fifo.state", "-o", "y.exr"], "not a regular file");
+    // A FIFO given to --resume is refused, not read (reading would block).
+    refused(&["render", "--resume", "fifo.state", "-o", "y.exr"], "not a regular file");
+    std::fs::write(d.join("bad.state"), b"MISLABST but then nothing sensible").unwrap();
+    refused(&["render", "--resume", "bad.state", "-o", "y.exr"], "bad.state");
+
+    // A whole render with settings far from the defaults, then `--resume` with nothing else: the same image.
+    let settings = ["--width", "40", "--height", "24", "--seed", "7", "--strategy", "light", "--sampler", "sobol"];
+    run_ok(
+        bin()
+            .current_dir(&d)
+            .args(["render", "veach-mis", "--spp", "8"])
+            .args(settings)
+            .args(["--state", "a.state", "-o", "a.exr"]),
+    );
+    let t = run_ok(bin().current_dir(&d).args(["render", "veach-mis", "--resume", "a.state", "-o", "b.exr"]));
+    assert!(t.contains("resuming"), "{t}");
+    let a = RenderState::read(&d.join("a.state")).unwrap();
+    assert_eq!((a.header.settings.seed, a.header.spp_total, a.header.next), (7, 8, 8));
+    // The EXRs hold the same pixels (their headers differ only in the render time).
+    let pixels = |n: &str| mislab::lab::compare::read(&d.join(n)).unwrap().pixels;
+    assert_eq!(pixels("a.exr"), pixels("b.exr"));
+    // A flag given with another value than the state's is refused by name.
+    let (code, t) = run_code(bin().current_dir(&d).args([
+        "render",
+        "veach-mis",
+        "--resume",
+        "a.state",
+        "--seed",
+        "8",
+        "-o",
+        "c.exr",
+    ]));
+    assert_eq!(code, 2, "{t}");
+    assert!(t.contains("a.state") && t.contains("seed: 7 vs 8"), "{t}");
+    let _ = std::fs::remove_dir_all(&d);
+}

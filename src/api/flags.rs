@@ -26,6 +26,10 @@ pub struct RenderFlags {
     /// State files, checkpoints, resume and parts (src/state).
     #[command(flatten)]
     pub state: StateArgs,
+    /// The flags given explicitly (keyword names, `_` for `-`), where the front end knows them: a resumed render
+    /// takes every other setting from its state file. None: a flag left at its default counts as not given.
+    #[arg(skip)]
+    pub given: Option<Vec<String>>,
 }
 
 /// `RenderFlags` as a command of its own, to parse name–value pairs and to list every flag.
@@ -54,7 +58,18 @@ impl RenderFlags {
     /// An unknown name or a bad value is an `ApiError::Settings` with clap's message.
     pub fn from_pairs<K: AsRef<str>, V: AsRef<str>>(pairs: &[(K, V)]) -> Result<RenderFlags, ApiError> {
         let argv = pairs.iter().map(|(k, v)| format!("--{}={}", k.as_ref().replace('_', "-"), v.as_ref()));
-        FlagsOnly::try_parse_from(argv).map(|p| p.flags).map_err(|e| ApiError::Settings(clap_message(&e)))
+        let mut flags =
+            FlagsOnly::try_parse_from(argv).map(|p| p.flags).map_err(|e| ApiError::Settings(clap_message(&e)))?;
+        flags.given = Some(pairs.iter().map(|(k, _)| k.as_ref().replace('-', "_")).collect());
+        Ok(flags)
+    }
+
+    /// Whether flag `name` (keyword form) was given: by the front end's list, else by differing from its default.
+    pub fn was_given(&self, name: &str, differs_from_default: bool) -> bool {
+        match &self.given {
+            Some(given) => given.iter().any(|g| g == name),
+            None => differs_from_default,
+        }
     }
 
     /// Every flag with its help, default and allowed values.

@@ -7,6 +7,7 @@ use super::flags::RenderFlags;
 use super::scene::SceneHandle;
 use crate::render::settings::Settings;
 use crate::state::session::Session;
+use crate::state::StateHeader;
 use std::path::Path;
 
 /// A render to do: the settings, the budget, and the state file it resumes from and writes, if any.
@@ -32,8 +33,13 @@ impl Job {
     /// `.state` is the default state file; without it, state flags need `state` (or `resume`) to name one.
     pub fn new(flags: &RenderFlags, output: Option<&Path>) -> Result<Job, ApiError> {
         flags.settings.validate().map_err(ApiError::Settings)?;
-        let (budget, note) = flags.budget()?;
         let session = Session::open(&flags.state, flags.spp, output).map_err(ApiError::State)?;
+        let resumed = session.as_ref().and_then(|s| s.resumed_header().map(|h| (s.path(), h)));
+        let flags = match resumed {
+            Some((path, saved)) => resume_defaults(flags, path, saved)?,
+            None => flags.clone(),
+        };
+        let (budget, note) = flags.budget()?;
         Ok(Job {
             settings: flags.settings.clone(),
             budget,
@@ -82,4 +88,32 @@ impl Job {
     pub fn state_path(&self) -> Option<&Path> {
         self.session.as_ref().map(|s| s.path())
     }
+}
+
+/// The flags of a resumed render: the state's sample count and settings where the flags did not give them. A flag
+/// given with another value than the state's is kept, and `Session::start` refuses the resume naming every
+/// difference (the scene's too).
+fn resume_defaults(flags: &RenderFlags, path: &Path, saved: &StateHeader) -> Result<RenderFlags, ApiError> {
+    if flags.time.is_some() {
+        return Err(ApiError::State(format!(
+            "{}: a resumed render continues to the state's sample count ({} spp): --time cannot be given",
+            path.display(),
+            saved.spp_total
+        )));
+    }
+    let map = |s: &Settings| match serde_json::to_value(s) {
+        Ok(serde_json::Value::Object(m)) => m,
+        _ => Default::default(),
+    };
+    let (asked, default) = (map(&flags.settings), map(&Settings::default()));
+    let mut merged = map(&saved.settings);
+    for (name, value) in asked {
+        if flags.was_given(&name, default.get(&name) != Some(&value)) {
+            merged.insert(name, value);
+        }
+    }
+    let settings: Settings = serde_json::from_value(serde_json::Value::Object(merged))
+        .map_err(|e| ApiError::State(format!("{}: the state's settings cannot be read: {e}", path.display())))?;
+    settings.validate().map_err(|e| ApiError::State(format!("{}: {e}", path.display())))?;
+    Ok(RenderFlags { spp: Some(flags.spp.unwrap_or(saved.spp_total)), settings, ..flags.clone() })
 }

@@ -169,6 +169,7 @@ pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
         time: args.time,
         settings: settings.clone(),
         state: StateArgs { state: args.state.clone(), part: args.part, ..StateArgs::default() },
+        given: None,
     };
     let mut job = api::Job::new(&flags, Some(&args.output))?;
     job.verify_complete = true;

@@ -294,7 +294,12 @@ impl RenderState {
 
     /// Reads a state file.
     pub fn read(path: &Path) -> Result<RenderState, String> {
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read the state file: {e}", path.display()))?;
+        // A regular file only: a FIFO or a device in its place must not block or never end.
+        let (mut file, _) = crate::io::input_file::open_regular(path)
+            .map_err(|e| format!("{}: cannot read the state file: {e}", path.display()))?;
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(&mut file, &mut bytes)
+            .map_err(|e| format!("{}: cannot read the state file: {e}", path.display()))?;
         RenderState::from_bytes(&bytes, &path.display().to_string())
     }
 

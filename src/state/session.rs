@@ -71,15 +71,16 @@ impl Session {
         if !args.active() {
             return Ok(None);
         }
-        if spp.is_none() {
-            return Err("--state, --checkpoint-every, --resume and --part need --spp N (the sample range a state holds is fixed by it; --time is not reproducible)".into());
+        // The state to resume first: it says the render's sample count and part, and a bad file is reported as such.
+        let resumed = args.resume.as_deref().map(RenderState::read).transpose()?;
+        if spp.is_none() && resumed.is_none() {
+            return Err("--state, --checkpoint-every and --part need --spp N (the sample range a state holds is fixed by it; --time is not reproducible)".into());
         }
         let every = match args.checkpoint_every {
             None => None,
             Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
             Some(t) => return Err(format!("--checkpoint-every {t} must be a positive number of seconds")),
         };
-        let resumed = args.resume.as_deref().map(RenderState::read).transpose()?;
         let path = match (args.state.clone().or_else(|| args.resume.clone()), output) {
             (Some(path), _) => path,
             (None, Some(output)) => output.with_extension("state"),
@@ -87,7 +88,16 @@ impl Session {
                 return Err("--part and --checkpoint-every need --state FILE (the state file to write)".into())
             }
         };
-        Ok(Some(Session { path, every, part: args.part, resumed, header: None, seconds_before: 0.0 }))
+        check_state_path(&path, output)?;
+        // A resumed part stays that part unless --part says otherwise (then `start` refuses a mismatch by name).
+        let part = args.part.or(resumed.as_ref().and_then(|r| r.header.part));
+        Ok(Some(Session { path, every, part, resumed, header: None, seconds_before: 0.0 }))
+    }
+
+    /// The header of the state this run resumes, if it resumes one (its settings and sample count are the run's
+    /// defaults: `api::Job`).
+    pub fn resumed_header(&self) -> Option<&StateHeader> {
+        self.resumed.as_ref().map(|r| &r.header)
     }
 
     /// The state file this run writes.
@@ -195,4 +205,40 @@ impl Session {
         };
         RenderState::from_film(header, &film).write(&self.path)
     }
+}
+
+/// Refuses a state path that is the output image too (the image written after the state would replace it) or that
+/// is something other than a regular file (a directory, FIFO or device cannot hold a state, and a FIFO would block).
+fn check_state_path(path: &Path, output: Option<&Path>) -> Result<(), String> {
+    if let Some(output) = output {
+        if same_file(path, output) {
+            return Err(format!(
+                "{}: the state file and the output image are the same file (the image would overwrite the state); \
+                 name the state with --state",
+                path.display()
+            ));
+        }
+    }
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => {
+            let kind = if m.is_dir() { "a directory" } else { "not a regular file (a FIFO, socket or device)" };
+            Err(format!("{}: is {kind}; a render state is written to a regular file", path.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Whether two paths name the same file, whether or not it exists yet (their folders resolved, links followed).
+fn same_file(a: &Path, b: &Path) -> bool {
+    let resolve = |p: &Path| -> PathBuf {
+        if let Ok(c) = p.canonicalize() {
+            return c;
+        }
+        let parent = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        match (parent.canonicalize(), p.file_name()) {
+            (Ok(d), Some(n)) => d.join(n),
+            _ => p.to_path_buf(),
+        }
+    };
+    resolve(a) == resolve(b)
 }
