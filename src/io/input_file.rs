@@ -12,7 +12,7 @@
 
 use std::fs::File;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const MIB: u64 = 1 << 20;
 /// TOML scene files: text written by hand or by scripts; far larger is a mistake (or an attack).
@@ -23,6 +23,9 @@ pub const MAX_GLTF_BYTES: u64 = 2048 * MIB;
 pub const MAX_IMAGE_BYTES: u64 = 512 * MIB;
 /// Environment maps (.hdr / .exr): a 16k × 8k float RGB EXR is 1.5 GiB uncompressed.
 pub const MAX_ENVMAP_BYTES: u64 = 2048 * MIB;
+/// pbrt / Mitsuba scene text and the meshes and images they reference, and what a gzip'd mesh (`.ply.gz`)
+/// inflates to: the limit counts the inflated bytes, so a "zip bomb" stops there (`read_limited`).
+pub const MAX_IMPORT_BYTES: u64 = MAX_GLTF_BYTES;
 
 /// Human size for messages: "12.0 MiB (12582912 bytes)".
 fn size(bytes: u64) -> String {
@@ -123,6 +126,89 @@ pub fn read_prefix(path: &Path, max: u64) -> Result<Vec<u8>, String> {
     Ok(bytes)
 }
 
+/// Reads `reader` to its end if that is at most `limit` bytes, growing the buffer step by step (never past the
+/// limit, and never by an allocation that fails: that is an error too) so that a stream that never ends, such as
+/// a gzip "zip bomb", costs at most `limit` bytes of memory before the error.
+pub fn read_limited(mut reader: impl Read, limit: u64) -> Result<Vec<u8>, String> {
+    let over = || format!("inflates to more than {}, the limit for this kind of input", size(limit));
+    let mut bytes: Vec<u8> = Vec::new();
+    let mut chunk = vec![0u8; 1 << 16];
+    loop {
+        let n = match reader.read(&mut chunk) {
+            Ok(0) => return Ok(bytes),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(format!("cannot be read: {e}")),
+        };
+        if (bytes.len() + n) as u64 > limit {
+            return Err(over());
+        }
+        if bytes.capacity() - bytes.len() < n {
+            // Double, but never past the limit.
+            let want = (bytes.capacity() * 2).max(1 << 20).min(limit as usize) - bytes.len();
+            bytes.try_reserve_exact(want.max(n)).map_err(|_| {
+                format!("needs more memory than is available (at {} inflated)", size(bytes.len() as u64))
+            })?;
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+}
+
+/// Why `resolve_inside` refused a file name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outside {
+    /// An absolute path.
+    Absolute,
+    /// `..` climbs above the base directory.
+    ParentDir,
+    /// The path exists and, with its symbolic links followed, lies outside the base directory.
+    Symlink,
+}
+
+impl Outside {
+    /// What is wrong, as words after the name ("'x' is an absolute path").
+    pub fn describe(self, base_is: &str) -> String {
+        match self {
+            Outside::Absolute => "is an absolute path".into(),
+            Outside::ParentDir => format!("leads outside {base_is}"),
+            Outside::Symlink => format!("leads outside {base_is} through a symbolic link"),
+        }
+    }
+}
+
+/// `base.join(rel)`, if it stays inside `base` (or `allow_outside`): not absolute, never climbing above `base`
+/// by `..`, and — when the file exists — not reaching out of it through a symbolic link. A scene file may then
+/// name only files of its own folder, as the glTF loader's URIs (`--allow-outside-paths` lifts it).
+pub fn resolve_inside(base: &Path, rel: &Path, allow_outside: bool) -> Result<PathBuf, Outside> {
+    use std::path::Component;
+    let path = base.join(rel);
+    if allow_outside {
+        return Ok(path);
+    }
+    let mut depth = 0i64;
+    for c in rel.components() {
+        match c {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => {
+                depth -= 1;
+                if depth < 0 {
+                    return Err(Outside::ParentDir);
+                }
+            }
+            Component::RootDir | Component::Prefix(_) => return Err(Outside::Absolute),
+        }
+    }
+    // `Path::new("")` (a scene named without a directory) is the current one.
+    let base = if base.as_os_str().is_empty() { Path::new(".") } else { base };
+    if let (Ok(target), Ok(base)) = (base.join(rel).canonicalize(), base.canonicalize()) {
+        if !target.starts_with(&base) {
+            return Err(Outside::Symlink);
+        }
+    }
+    Ok(path)
+}
+
 /// `read_bounded` for UTF-8 text.
 pub fn read_bounded_text(path: &Path, limit: u64) -> Result<String, String> {
     let bytes = read_bounded(path, limit)?;
@@ -189,6 +275,23 @@ mod tests {
         let e = read_bounded(&p, 9).unwrap_err();
         assert!(e.contains("over the limit") && !e.contains("secret"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn read_limited_stops_an_endless_stream() {
+        let zeros = std::io::repeat(0).take(10 << 20);
+        let e = read_limited(zeros, 1 << 20).unwrap_err();
+        assert!(e.contains("more than 1.0 MiB"), "{e}");
+        assert_eq!(read_limited(&b"abc"[..], 3).unwrap(), b"abc");
+    }
+
+    #[test]
+    fn resolve_inside_refuses_what_leaves_the_base() {
+        let base = Path::new("/tmp/scene");
+        assert_eq!(resolve_inside(base, Path::new("/etc/passwd"), false), Err(Outside::Absolute));
+        assert_eq!(resolve_inside(base, Path::new("a/../../x"), false), Err(Outside::ParentDir));
+        assert_eq!(resolve_inside(base, Path::new("a/../x"), false), Ok(base.join("a/../x")));
+        assert_eq!(resolve_inside(base, Path::new("/etc/passwd"), true), Ok(PathBuf::from("/etc/passwd")));
     }
 
     #[test]

@@ -31,7 +31,22 @@ pub fn flat_counts(data: &SceneData) -> Option<(u32, u32, u32)> {
 }
 
 /// A WGSL f32 literal that round-trips exactly (Rust's shortest representation, with the `f` suffix).
+///
+/// WGSL has no literal for an infinity or a NaN (`inf.0f` fails to validate): a non-finite value is never written.
+/// The loaders refuse them (`scene::check_finite`), so one here is a bug upstream; it is logged and written as the
+/// nearest finite value (±f32::MAX, and 0 for NaN) so that the shader still validates.
 fn lit(x: f32) -> String {
+    let x = if x.is_finite() {
+        x
+    } else {
+        log::error!("baked shader: non-finite value {x} written as a finite literal (a scene value escaped checks)");
+        debug_assert!(false, "non-finite value {x} in a baked shader literal");
+        if x.is_nan() {
+            0.0
+        } else {
+            f32::MAX.copysign(x)
+        }
+    };
     let s = format!("{x:?}");
     if s.contains(['.', 'e', 'E']) {
         format!("{s}f")
@@ -550,6 +565,17 @@ fn test_prim(out: &mut String, query: Query, prim: u32, call: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// No literal is ever an infinity or a NaN, which WGSL cannot spell.
+    #[test]
+    #[cfg(not(debug_assertions))]
+    fn literals_are_always_finite() {
+        assert_eq!(lit(f32::INFINITY), "3.4028235e38f");
+        assert_eq!(lit(f32::NEG_INFINITY), "-3.4028235e38f");
+        assert_eq!(lit(f32::NAN), "0.0f");
+        assert_eq!(lit(1.5), "1.5f");
+        assert_eq!(lit(2.0), "2.0f");
+    }
 
     /// The member lists read from common.wgsl cover every 4-byte word of the Rust twins (no padding words
     /// exist in these structs: their vec3s are followed by a scalar).

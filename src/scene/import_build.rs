@@ -5,6 +5,7 @@
 use super::import_material::{self, Mapped, MaterialDesc};
 use super::import_texture::TextureCache;
 use super::{Mesh, Scene, SceneError, Sphere};
+use crate::io::input_file::clip;
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::collections::{BTreeMap, HashMap};
 
@@ -24,6 +25,8 @@ pub struct Builder {
     pub warnings: Vec<String>,
     /// Ignored features: what → how often.
     pub ignored: BTreeMap<String, usize>,
+    /// Where each ignored feature that has a place was first met (`scene.pbrt: line 12`).
+    pub ignored_at: BTreeMap<String, String>,
     /// Imported things: what → how many.
     pub imported: BTreeMap<String, usize>,
     /// Shapes left out because their material is invisible.
@@ -48,6 +51,13 @@ impl Builder {
     /// Notes one ignored feature.
     pub fn ignore(&mut self, what: impl Into<String>) {
         *self.ignored.entry(what.into()).or_default() += 1;
+    }
+    /// Notes one ignored feature met at `at` (`scene.pbrt: line 12`); the warning and the import report name the
+    /// first place.
+    pub fn ignore_at(&mut self, what: impl Into<String>, at: String) {
+        let what = what.into();
+        self.ignored_at.entry(what.clone()).or_insert(at);
+        self.ignore(what);
     }
     /// Counts one imported thing.
     pub fn count(&mut self, what: &str, n: usize) {
@@ -94,11 +104,12 @@ impl Builder {
     /// The cut-out mask of image `file` (a texture whose alpha channel is the coverage, shaders/alpha.wgsl): the
     /// image's alpha channel where it has one that is not all opaque, else its first channel (pbrt-v4's float
     /// texel). A leaf texture with transparent surroundings cuts them out either way.
-    pub fn alpha_mask(&mut self, file: &std::path::Path) -> Result<u32, SceneError> {
+    /// `referenced_by` (`scene.pbrt: line 12`) is named in errors about the image.
+    pub fn alpha_mask(&mut self, file: &std::path::Path, referenced_by: &str) -> Result<u32, SceneError> {
         if let Some(&t) = self.masks.get(file) {
             return Ok(t);
         }
-        let (width, height, mut texels) = super::import_texture::load_rgba8(file, false)?;
+        let (width, height, mut texels) = super::import_texture::load_rgba8(file, false, referenced_by)?;
         if texels.iter().all(|c| c[3] == 255) {
             for c in &mut texels {
                 c[3] = c[0];
@@ -137,9 +148,29 @@ impl Builder {
 
     /// Places `mesh` with `to_world`. Triangles face their vertex normals when there are any; otherwise they
     /// are flipped when `flip` (pbrt: ReverseOrientation xor a handedness-swapping transform) and get flat normals.
-    pub fn add_mesh(&mut self, mesh: ObjectMesh, to_world: Mat4, flip: bool, material: u32) {
+    /// A position or uv that is not a finite 32-bit float (in the file, or once transformed) is an error: the
+    /// problem alone, which the caller places in its file.
+    pub fn add_mesh(&mut self, mesh: ObjectMesh, to_world: Mat4, flip: bool, material: u32) -> Result<(), String> {
+        if !to_world.is_finite() {
+            return Err("the shape's transform is out of the range of 32-bit floats".into());
+        }
+        if Mat3::from_mat4(to_world).determinant() == 0.0 {
+            return Err("the shape's transform is singular (its 3×3 part has determinant 0)".into());
+        }
+        if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {i} of '{}' is not a finite 32-bit float", clip(&mesh.name, 80)));
+        }
+        if let Some(i) = mesh.uvs.iter().position(|t| !t.is_finite()) {
+            return Err(format!("texture coordinate {i} of '{}' is not a finite 32-bit float", clip(&mesh.name, 80)));
+        }
         let normal_m = Mat3::from_mat4(to_world).inverse().transpose();
         let p: Vec<Vec3> = mesh.positions.iter().map(|&p| to_world.transform_point3(p)).collect();
+        if let Some(i) = p.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "vertex {i} of '{}' is out of the range of 32-bit floats once transformed",
+                clip(&mesh.name, 80)
+            ));
+        }
         let n: Vec<Vec3> = mesh.normals.iter().map(|&n| (normal_m * n).normalize_or(Vec3::Y)).collect();
         // Our textures are top row first (v down); pbrt and Mitsuba put v = 0 at the bottom.
         let uv: Vec<Vec2> = mesh.uvs.iter().map(|&t| Vec2::new(t.x, 1.0 - t.y)).collect();
@@ -184,14 +215,24 @@ impl Builder {
         }
         self.count("triangles", out.indices.len());
         self.scene.meshes.push(out);
+        Ok(())
     }
 
-    /// Places a sphere of `radius` at the origin of `to_world` (uniform scale assumed; the mean is used).
-    pub fn add_sphere(&mut self, to_world: Mat4, radius: f32, material: u32) {
+    /// Places a sphere of `radius` at the origin of `to_world` (uniform scale assumed; the mean is used). A
+    /// singular transform or a centre or radius out of the range of 32-bit floats is an error (the problem alone).
+    pub fn add_sphere(&mut self, to_world: Mat4, radius: f32, material: u32) -> Result<(), String> {
         let center = to_world.transform_point3(Vec3::ZERO);
         let scale = Mat3::from_mat4(to_world).determinant().abs().cbrt();
-        self.scene.spheres.push(Sphere { center, radius: radius * scale, material });
+        let radius = radius * scale;
+        if !to_world.is_finite() || !(radius > 0.0 && radius.is_finite()) || !center.is_finite() {
+            return Err(format!(
+                "the sphere's transform is singular, or its centre or radius ({radius}) is out of the range of 32-bit \
+                 floats"
+            ));
+        }
+        self.scene.spheres.push(Sphere { center, radius, material });
         self.count("spheres", 1);
+        Ok(())
     }
 
     /// Ends the import: the ignored list becomes one warning, and the import report is filled in.
@@ -203,9 +244,16 @@ impl Builder {
                 self.invisible_shapes
             ));
         }
+        let placed = |k: &String| match self.ignored_at.get(k) {
+            Some(at) => format!("{k} (at {at})"),
+            None => k.clone(),
+        };
         if !self.ignored.is_empty() {
-            let list: Vec<String> =
-                self.ignored.iter().map(|(k, n)| if *n > 1 { format!("{k} (×{n})") } else { k.clone() }).collect();
+            let list: Vec<String> = self
+                .ignored
+                .iter()
+                .map(|(k, n)| if *n > 1 { format!("{} (×{n}, first)", placed(k)) } else { placed(k) })
+                .collect();
             self.scene.warnings.push(format!("{format}: ignored (not supported by mislab): {}", list.join("; ")));
         }
         let mut report = vec![format!("imported from {format}:")];
@@ -224,7 +272,7 @@ impl Builder {
             report.push("ignored: nothing".into());
         } else {
             report.push("ignored:".into());
-            report.extend(self.ignored.iter().map(|(k, n)| format!("  {k} ×{n}")));
+            report.extend(self.ignored.iter().map(|(k, n)| format!("  {} ×{n}", placed(k))));
         }
         self.scene.import_report = report;
         self.scene

@@ -21,6 +21,8 @@ pub struct TexDesc {
     pub scale: Vec3,
     /// Whether 8-bit texels are sRGB-encoded (pbrt's default for 8-bit images; Mitsuba's `raw` = false).
     pub srgb: bool,
+    /// Where the scene names the file (`scene.pbrt: line 12`), for errors about it.
+    pub referenced_by: String,
 }
 
 /// One typed material parameter.
@@ -59,6 +61,19 @@ pub struct MaterialDesc {
     pub kind: String,
     /// Every parameter, by name.
     pub params: BTreeMap<String, MatParam>,
+    /// Where the file declares it (`scene.pbrt: line 12`), named in the warnings; empty for a format's defaults.
+    pub at: String,
+}
+
+impl MaterialDesc {
+    /// "name (kind, scene.pbrt: line 12)" for messages.
+    fn shown(&self) -> String {
+        if self.at.is_empty() || self.name == self.at {
+            format!("{} ({})", self.name, self.kind)
+        } else {
+            format!("{} ({}, {})", self.name, self.kind, self.at)
+        }
+    }
 }
 
 /// What a description becomes.
@@ -141,7 +156,7 @@ pub fn map(
     cache: &mut TextureCache,
     warnings: &mut Vec<String>,
 ) -> Result<Mapped, SceneError> {
-    let mut warn = |what: &str| warnings.push(format!("material {} ({}) approximated as {what}", desc.name, desc.kind));
+    let mut warn = |what: &str| warnings.push(format!("material {} approximated as {what}", desc.shown()));
     let m = match desc.kind.as_str() {
         "diffuse" => {
             let (c, t) = color(desc, &["reflectance"], Vec3::splat(0.5), scene, cache)?;
@@ -265,7 +280,7 @@ fn coated_diffuse(
     cache: &mut TextureCache,
     warnings: &mut Vec<String>,
 ) -> Result<Mapped, SceneError> {
-    let mut warn = |what: &str| warnings.push(format!("material {} ({}): {what}", desc.name, desc.kind));
+    let mut warn = |what: &str| warnings.push(format!("material {}: {what}", desc.shown()));
     let f = |n: &str| match desc.params.get(n) {
         Some(MatParam::Float(v)) => Some(*v),
         Some(MatParam::Rgb(c)) => Some(c.x),
@@ -406,7 +421,7 @@ fn color(
             Some(MatParam::Rgb(c)) => return Ok((*c * scale, None)),
             Some(MatParam::Float(f)) => return Ok((Vec3::splat(*f * scale), None)),
             Some(MatParam::Texture(t)) => {
-                let index = cache.load(&t.file, t.srgb, scene)?;
+                let index = cache.load(&t.file, t.srgb, &t.referenced_by, scene)?;
                 let r = TextureRef { texture: index, transform: t.uv, texcoord: 0 };
                 return Ok((t.scale * scale, Some(r)));
             }
@@ -492,6 +507,7 @@ mod tests {
             name: "m".into(),
             kind: kind.into(),
             params: params.into_iter().map(|(n, p)| (n.to_string(), p)).collect(),
+            at: String::new(),
         }
     }
 

@@ -479,7 +479,8 @@ impl Scene {
 pub struct LoadOptions {
     /// glTF scene index (`--gltf-scene N`); None = the file's default scene (or scene 0).
     pub gltf_scene: Option<usize>,
-    /// Follow glTF URIs that are absolute or leave the file's directory (`--allow-outside-paths`).
+    /// Follow file names (glTF URIs; pbrt and Mitsuba includes, meshes and images) that are absolute or leave the
+    /// scene file's directory (`--allow-outside-paths`).
     pub allow_outside_paths: bool,
     /// Bytes the scene's RGBA8 texels may take (the device's storage-binding limit when known); images
     /// that would not fit are refused before they are decoded.
@@ -513,6 +514,72 @@ pub fn check_packing_limits(path: &Path, scene: &Scene) -> Result<(), SceneError
     Ok(())
 }
 
+/// Whether a punctual light's numbers are all finite.
+pub fn punctual_light_is_finite(l: &PunctualLight) -> bool {
+    match *l {
+        PunctualLight::Point { position, intensity } => position.is_finite() && intensity.is_finite(),
+        PunctualLight::Spot { position, direction, intensity, inner_cone, outer_cone } => {
+            position.is_finite()
+                && direction.is_finite()
+                && intensity.is_finite()
+                && inner_cone.is_finite()
+                && outer_cone.is_finite()
+        }
+        PunctualLight::Directional { direction, irradiance } => direction.is_finite() && irradiance.is_finite(),
+    }
+}
+
+/// Refuses (naming the file and the object) a scene with a number that is not finite: a triangle's position or uv, a
+/// sphere or quad, a material's colour or emission, a light, the environment or the camera. The importers check
+/// these with their file and line as they read; this is the backstop `load` applies to every format, so that no
+/// infinity or NaN reaches the renderer (or a baked shader's literals).
+pub fn check_finite(path: &Path, scene: &Scene) -> Result<(), SceneError> {
+    let bad = |what: String| {
+        Err(SceneError::new(path, format!("{what} is not a finite number (out of the range of 32-bit floats?)")))
+    };
+    let clip = |s: &str| crate::io::input_file::clip(s, 80);
+    // The vertices some triangle uses (a loader may keep unused ones as the file has them).
+    for m in &scene.meshes {
+        for &i in m.indices.iter().flatten() {
+            if m.positions.get(i as usize).is_some_and(|p| !p.is_finite()) {
+                return bad(format!("mesh '{}': vertex {i}", clip(&m.name)));
+            }
+            if m.uvs.get(i as usize).is_some_and(|t| !t.is_finite()) {
+                return bad(format!("mesh '{}': the uv of vertex {i}", clip(&m.name)));
+            }
+        }
+    }
+    if let Some(i) = scene.spheres.iter().position(|s| !(s.center.is_finite() && s.radius.is_finite())) {
+        return bad(format!("sphere {i}"));
+    }
+    if let Some(i) =
+        scene.quads.iter().position(|q| !(q.corner.is_finite() && q.edge_u.is_finite() && q.edge_v.is_finite()))
+    {
+        return bad(format!("quad {i}"));
+    }
+    for m in &scene.materials {
+        let numbers = [m.metallic, m.roughness, m.specular];
+        if !(m.base_color.is_finite() && m.emission.is_finite() && numbers.iter().all(|x| x.is_finite())) {
+            return bad(format!("material '{}': a colour, emission or factor", clip(&m.name)));
+        }
+    }
+    if let Some(i) = scene.punctual_lights.iter().position(|l| !punctual_light_is_finite(l)) {
+        return bad(format!("light {i}"));
+    }
+    match &scene.environment {
+        Environment::Constant(c) if !c.is_finite() => return bad("the environment's radiance".into()),
+        Environment::Map { scale, rotation, .. } if !(scale.is_finite() && rotation.is_finite()) => {
+            return bad("the environment map's scale or rotation".into())
+        }
+        _ => {}
+    }
+    let c = &scene.camera;
+    if !(c.position.is_finite() && c.forward.is_finite() && c.up.is_finite() && c.vfov.is_finite()) {
+        return bad("the camera's position, direction or field of view".into());
+    }
+    Ok(())
+}
+
 /// Loads a scene from a file (`.gltf`, `.glb`, `.toml`) or a built-in name (see `builtin::NAMES`).
 /// Never panics: loader panics on malformed files are caught and turned into errors naming the file.
 pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneError> {
@@ -537,8 +604,8 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
     let result = catch_quietly(|| match ext.as_str() {
         "gltf" | "glb" => gltf::load(path, options),
         "toml" => toml::load(path, options),
-        "pbrt" => pbrt::load(path),
-        "xml" => mitsuba::load(path),
+        "pbrt" => pbrt::load_with(path, options),
+        "xml" => mitsuba::load_with(path, options),
         _ => Err(SceneError::new(
             path,
             format!(
@@ -548,7 +615,7 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         )),
     });
     match result {
-        Ok(r) => r.and_then(|s| check_packing_limits(path, &s).map(|()| s)),
+        Ok(r) => r.and_then(|s| check_packing_limits(path, &s).and_then(|()| check_finite(path, &s)).map(|()| s)),
         Err(what) => Err(SceneError::new(path, format!("malformed file (the loader failed: {what})"))),
     }
 }

@@ -51,6 +51,47 @@ pub fn lookup(name: &str, part: Part) -> Option<Vec3> {
     Some(Vec3::from_array(if part == Part::Eta { *eta } else { *k }))
 }
 
+/// Whether `name` is one of pbrt-v4's named spectra (its `GetNamedSpectrum` table, src/pbrt/util/spectrum.cpp):
+/// the glasses, metals and standard illuminants, and the camera sensors' `_r` / `_g` / `_b` curves.
+pub fn is_pbrt_name(name: &str) -> bool {
+    const GLASSES: &[&str] = &["BK7", "BAF10", "FK51A", "LASF9", "F5", "F10", "F11"];
+    const METALS: &[&str] = &["Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"];
+    const CAMERAS: &[&str] = &[
+        "canon_eos_100d",
+        "canon_eos_1dx_mkii",
+        "canon_eos_200d",
+        "canon_eos_200d_mkii",
+        "canon_eos_5d",
+        "canon_eos_5d_mkii",
+        "canon_eos_5d_mkiii",
+        "canon_eos_5d_mkiv",
+        "canon_eos_5ds",
+        "canon_eos_m",
+        "hasselblad_l1d_20c",
+        "nikon_d810",
+        "nikon_d850",
+        "sony_ilce_6400",
+        "sony_ilce_7m3",
+        "sony_ilce_7rm3",
+        "sony_ilce_9",
+    ];
+    if let Some(g) = name.strip_prefix("glass-") {
+        return GLASSES.contains(&g);
+    }
+    if let Some((metal, part)) = name.strip_prefix("metal-").and_then(|r| r.rsplit_once('-')) {
+        return METALS.contains(&metal) && (part == "eta" || part == "k");
+    }
+    if let Some(i) = name.strip_prefix("stdillum-") {
+        const ILLUMINANTS: &[&str] =
+            &["A", "D50", "D65", "F1", "F2", "F3", "F4", "F5", "F6", "F7", "F8", "F9", "F10", "F11", "F12"];
+        return ILLUMINANTS.contains(&i);
+    }
+    if name == "illum-acesD60" {
+        return true;
+    }
+    name.rsplit_once('_').is_some_and(|(camera, c)| CAMERAS.contains(&camera) && matches!(c, "r" | "g" | "b"))
+}
+
 /// Normal-incidence reflectance of RGB η + i·k: ((η − 1)² + k²) / ((η + 1)² + k²) per channel.
 pub fn f0(eta: Vec3, k: Vec3) -> Vec3 {
     let f = |n: f32, k: f32| ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
@@ -72,5 +113,15 @@ mod tests {
         // CuZn: η = 1 and k from its F0.
         let brass = f0(lookup("metal-CuZn-eta", Part::Eta).unwrap(), lookup("metal-CuZn-k", Part::K).unwrap());
         assert!((brass - Vec3::new(0.910, 0.778, 0.423)).abs().max_element() < 1e-3, "{brass}");
+    }
+
+    #[test]
+    fn pbrt_names() {
+        for n in ["glass-BK7", "metal-Au-k", "metal-TiO2-eta", "stdillum-F12", "stdillum-D65", "nikon_d850_g"] {
+            assert!(is_pbrt_name(n), "{n}");
+        }
+        for n in ["glass-XX", "metal-Au-x", "stdillum-F13", "stdillum-F01", "nikon_d850_x", "metal-Xx-eta", ""] {
+            assert!(!is_pbrt_name(n), "{n}");
+        }
     }
 }

@@ -53,7 +53,9 @@ pub fn decode(text: &str) -> Result<PlyMesh, String> {
                         match s {
                             None | Some("") => Ok(None),
                             Some(s) => {
-                                let i: i64 = s.parse().map_err(|_| format!("line {ln}: bad {what} index '{s}'"))?;
+                                let i: i64 = s.parse().map_err(|_| {
+                                    format!("line {ln}: bad {what} index '{}'", crate::io::input_file::clip(s, 24))
+                                })?;
                                 let r = if i > 0 { i - 1 } else { len as i64 + i };
                                 if i == 0 || r < 0 || r >= len as i64 {
                                     return Err(format!(
@@ -89,6 +91,10 @@ pub fn decode(text: &str) -> Result<PlyMesh, String> {
             _ => {}
         }
     }
+    if out.indices.is_empty() {
+        // Text with no face at all is no mesh (and most likely no OBJ file): an error, not an empty shape.
+        return Err("no faces ('f' records): is this an OBJ file?".into());
+    }
     if !(any_vn && all_vn) {
         out.normals.clear();
     }
@@ -108,5 +114,7 @@ mod tests {
         assert!(m.normals.is_empty());
         let e = super::decode("v 0 0 0\nf 1 2 3\n").unwrap_err();
         assert!(e.contains("line 2") && e.contains("out of range"), "{e}");
+        let e = super::decode("root:x:0:0:root:/root:/bin/bash\n").unwrap_err();
+        assert!(e.contains("no faces") && !e.contains("root"), "{e}");
     }
 }

@@ -110,16 +110,11 @@ impl Reader<'_> {
     }
 }
 
-/// Decodes a PLY file (gzip'd when it starts with the gzip magic).
+/// Decodes a PLY file (gzip'd when it starts with the gzip magic: inflated up to `input_file::MAX_IMPORT_BYTES`,
+/// the limit of a plain file, counted on the inflated bytes so that a "zip bomb" stops there).
 pub fn decode(bytes: &[u8]) -> Result<PlyMesh, String> {
     if bytes.starts_with(&[0x1f, 0x8b]) {
-        use std::io::Read;
-        let mut out = Vec::new();
-        flate2::read::GzDecoder::new(bytes)
-            .take(1 << 31)
-            .read_to_end(&mut out)
-            .map_err(|e| format!("corrupt gzip data: {e}"))?;
-        return decode(&out);
+        return decode_gz(bytes, crate::io::input_file::MAX_IMPORT_BYTES);
     }
     let end = find_header_end(bytes).ok_or("not a PLY file, or its header has no 'end_header' line")?;
     let header = std::str::from_utf8(&bytes[..end.0]).map_err(|_| "PLY header is not text")?;
@@ -226,10 +221,27 @@ pub fn decode(bytes: &[u8]) -> Result<PlyMesh, String> {
             t.iter().max().unwrap()
         ));
     }
-    if mesh.positions.iter().any(|p| !p.is_finite()) {
-        return Err("a vertex position is not finite".into());
+    // Values are read as f64 and stored as f32: 1e39 (ASCII) or a double out of range becomes an infinity.
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!("vertex {i}: its position is not a finite 32-bit float"));
+    }
+    if let Some(i) = mesh.normals.iter().position(|n| !n.is_finite()) {
+        return Err(format!("vertex {i}: its normal is not a finite 32-bit float"));
+    }
+    if let Some(i) = mesh.uvs.iter().position(|t| !t.is_finite()) {
+        return Err(format!("vertex {i}: its texture coordinate is not a finite 32-bit float"));
     }
     Ok(mesh)
+}
+
+/// Decodes gzip'd PLY bytes that inflate to at most `limit` bytes (`decode` with the plain files' limit).
+pub fn decode_gz(bytes: &[u8], limit: u64) -> Result<PlyMesh, String> {
+    let inflated = crate::io::input_file::read_limited(flate2::read::GzDecoder::new(bytes), limit)
+        .map_err(|e| format!("gzip data: {e}"))?;
+    if inflated.starts_with(&[0x1f, 0x8b]) {
+        return Err("gzip data that inflates to more gzip data (a PLY is compressed once)".into());
+    }
+    decode(&inflated)
 }
 
 /// Triangulates a polygon as a fan from its first vertex.
@@ -288,5 +300,26 @@ mod tests {
         b[n - 1] = 9;
         assert!(decode(&b).unwrap_err().contains("out of range"));
         assert!(decode(&b[..n - 2]).unwrap_err().contains("truncated"));
+    }
+
+    #[test]
+    fn a_gzip_bomb_stops_at_the_limit() {
+        use std::io::Write;
+        let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        gz.write_all(ASCII.as_bytes()).unwrap();
+        gz.write_all(&vec![b' '; 8 << 20]).unwrap();
+        let bytes = gz.finish().unwrap();
+        assert!(bytes.len() < 64 << 10);
+        let e = decode_gz(&bytes, 1 << 20).unwrap_err();
+        assert!(e.contains("inflates to more than 1.0 MiB"), "{e}");
+        assert_eq!(decode_gz(&bytes, 16 << 20).unwrap().positions.len(), 4);
+    }
+
+    #[test]
+    fn values_out_of_f32_range_are_errors() {
+        let e = decode(ASCII.replace("1 1 0 1 1", "1 1e39 0 1 1").as_bytes()).unwrap_err();
+        assert!(e.contains("vertex 2") && e.contains("finite"), "{e}");
+        let e = decode(ASCII.replace("1 1 0 1 1", "1 1 0 1e39 1").as_bytes()).unwrap_err();
+        assert!(e.contains("texture coordinate"), "{e}");
     }
 }

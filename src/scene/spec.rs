@@ -23,8 +23,9 @@ pub struct SceneSpec {
     /// Rotation of the --env map about +Y, degrees.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::io::cli_values::degrees)]
     pub env_rotation: f32,
-    /// Let glTF buffer and image URIs be absolute paths or lead outside the glTF file's directory (by `..` or
-    /// a symbolic link); without it such a URI is an error.
+    /// Let the files a scene names (glTF buffers and images; pbrt and Mitsuba includes, meshes, textures and maps)
+    /// be absolute paths or lead outside the scene file's directory (by `..` or a symbolic link); without it such a
+    /// file name is an error.
     #[arg(long)]
     pub allow_outside_paths: bool,
 }

@@ -92,9 +92,11 @@ impl Loader<'_> {
 }
 
 /// A camera that sees the whole scene: from +Z towards the bounding-box centre, 45° vertical field of view,
-/// far enough that the bounding sphere fits.
+/// far enough that the bounding sphere fits. Only vertices some triangle uses count: an unused one may be anything
+/// the file holds (a NaN, which would make the whole camera NaN).
 pub(super) fn frame_meshes(meshes: &[Mesh]) -> Camera {
-    let mut points = meshes.iter().flat_map(|m| m.positions.iter().copied());
+    let mut points =
+        meshes.iter().flat_map(|m| m.indices.iter().flatten().filter_map(|&i| m.positions.get(i as usize).copied()));
     let Some(first) = points.next() else { return Camera::default() };
     let (lo, hi) = points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let center = (lo + hi) * 0.5;

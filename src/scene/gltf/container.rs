@@ -263,36 +263,12 @@ pub(super) fn fetch_uri(uris: Uris, uri: &str, read: impl Fn(&Path) -> Res<Vec<u
 /// The file a relative URI names, refusing (unless allowed) absolute paths and paths that climb out of the
 /// glTF file's directory, by `..` or through a symbolic link.
 fn resolve(uris: Uris, rel: &str) -> Res<std::path::PathBuf> {
-    use std::path::Component;
+    use crate::io::input_file::{resolve_inside, Outside};
     let hint = "(resolved relative to the glTF file; allow it with --allow-outside-paths)";
-    let p = Path::new(rel);
-    let path = uris.base.join(p);
-    if uris.allow_outside {
-        return Ok(path);
-    }
-    let mut depth = 0i64;
-    for c in p.components() {
-        match c {
-            Component::Normal(_) => depth += 1,
-            Component::CurDir => {}
-            Component::ParentDir => {
-                depth -= 1;
-                if depth < 0 {
-                    return Err(format!("URI '{}' leads outside the glTF file's directory {hint}", shown(rel)));
-                }
-            }
-            Component::RootDir | Component::Prefix(_) => {
-                return Err(format!("URI '{}' is an absolute path {hint}", shown(rel)));
-            }
-        }
-    }
-    if let (Ok(target), Ok(base)) = (path.canonicalize(), uris.base.canonicalize()) {
-        if !target.starts_with(&base) {
-            let rel = shown(rel);
-            return Err(format!("URI '{rel}' leads outside the glTF file's directory through a symbolic link {hint}"));
-        }
-    }
-    Ok(path)
+    resolve_inside(uris.base, Path::new(rel), uris.allow_outside).map_err(|why| match why {
+        Outside::Absolute => format!("URI '{}' is an absolute path {hint}", shown(rel)),
+        _ => format!("URI '{}' {} {hint}", shown(rel), why.describe("the glTF file's directory")),
+    })
 }
 
 fn decode_data_uri(rest: &str) -> Res<Vec<u8>> {

@@ -3,11 +3,12 @@
 //! right-handed and its camera looks down +z with +x to the left, so directions map over unchanged.
 
 use super::xml::{self, Element};
+use crate::io::input_file::clip;
 use crate::scene::env_import::{self, Layout};
 use crate::scene::import_build::{self, Builder, ObjectMesh};
 use crate::scene::import_material::{MatParam, MaterialDesc, TexDesc};
-use crate::scene::read_input::read_bytes;
-use crate::scene::{Camera, Environment, PunctualLight, Scene, SceneError};
+use crate::scene::read_input::{at, included_from, read_bytes, SceneDir};
+use crate::scene::{Camera, Environment, LoadOptions, PunctualLight, Scene, SceneError};
 use glam::{DMat4, DVec3, Mat3, Vec3};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -19,7 +20,7 @@ const ENV_HEIGHT: u32 = 512;
 /// The loader's state.
 pub struct Loader {
     main: PathBuf,
-    dir: PathBuf,
+    dir: SceneDir,
     b: Builder,
     defaults: HashMap<String, String>,
     bsdfs: HashMap<String, usize>,
@@ -29,13 +30,15 @@ pub struct Loader {
 }
 
 impl Loader {
-    /// A loader for `main` (relative file names resolve against its directory).
-    pub fn new(main: &Path) -> Loader {
+    /// A loader for `main` (relative file names resolve against its directory, and may leave it only with
+    /// `options.allow_outside_paths`).
+    pub fn new(main: &Path, options: &LoadOptions) -> Loader {
         let mut b = Builder::default();
         let default_material = b.add_desc(MaterialDesc {
             name: "Mitsuba default (diffuse 0.5)".into(),
             kind: "diffuse".into(),
             params: BTreeMap::new(),
+            at: String::new(),
         });
         // Mitsuba 3 gives a shape with an area emitter and no BSDF a black diffuse one (shape.cpp): a lamp reflects
         // nothing. With diffuse 0.5 there, a lamp above a floor relit the floor: +0.9 % in a test scene.
@@ -43,10 +46,11 @@ impl Loader {
             name: "Mitsuba default for emitters (diffuse 0)".into(),
             kind: "diffuse".into(),
             params: BTreeMap::from([("reflectance".to_string(), MatParam::Rgb(Vec3::ZERO))]),
+            at: String::new(),
         });
         Loader {
             main: main.into(),
-            dir: main.parent().map(Path::to_path_buf).unwrap_or_default(),
+            dir: SceneDir::of(main, options.allow_outside_paths),
             b,
             defaults: HashMap::new(),
             bsdfs: HashMap::new(),
@@ -77,15 +81,17 @@ impl Loader {
         let bytes = read_bytes(path, by)?;
         let text = String::from_utf8(bytes)
             .map_err(|_| SceneError::new(path, "not UTF-8 text: is this a Mitsuba XML file?"))?;
-        let root = xml::parse(path, &text)?;
+        // An error in an included file names that file and line, and where it was included from.
+        let placed = |e| included_from(path, by, e);
+        let root = xml::parse(path, &text).map_err(placed)?;
         if root.tag != "scene" {
-            return Err(SceneError::new(
+            return Err(placed(SceneError::new(
                 path,
-                format!("line {}: the root element is <{}>, expected <scene>", root.line, root.tag),
-            ));
+                format!("line {}: the root element is <{}>, expected <scene>", root.line, clip(&root.tag, 40)),
+            )));
         }
         self.includes.push(canonical);
-        let r = root.children.iter().try_for_each(|e| self.top(path, e));
+        let r = root.children.iter().try_for_each(|e| self.top(path, e)).map_err(placed);
         self.includes.pop();
         r
     }
@@ -120,8 +126,8 @@ impl Loader {
             }
             "include" => {
                 let f = self.need(file, e, "filename")?;
-                let path = self.dir.join(f);
-                self.file(&path, &format!("{}: line {}", file.display(), e.line))?;
+                let path = self.dir.resolve(&f, file, e.line)?;
+                self.file(&path, &at(file, e.line))?;
             }
             "bsdf" => {
                 let index = self.bsdf(file, e)?;
@@ -133,8 +139,8 @@ impl Loader {
             "emitter" => self.emitter(file, e, None)?,
             "sensor" => self.sensor(file, e)?,
             "integrator" | "sampler" | "film" | "rfilter" | "medium" | "phase" => {
-                let t = e.attr("type").unwrap_or("");
-                self.b.ignore(format!("<{} type=\"{t}\">", e.tag));
+                let t = clip(e.attr("type").unwrap_or(""), 40);
+                self.b.ignore_at(format!("<{} type=\"{t}\">", e.tag), at(file, e.line));
             }
             "texture" => self.b.ignore("top-level <texture> (textures are read where they are used)"),
             other => return Err(self.err(file, e, format!("unknown element <{other}> in <scene>"))),
@@ -142,12 +148,16 @@ impl Loader {
         Ok(())
     }
 
+    /// Numbers separated by spaces or commas; each must be a finite 32-bit float (Mitsuba's `Float`): 1e39 would
+    /// become an infinity.
     fn numbers(&self, file: &Path, e: &Element, s: &str) -> Result<Vec<f64>, SceneError> {
         s.split(|c: char| c.is_whitespace() || c == ',')
             .filter(|w| !w.is_empty())
-            .map(|w| w.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .map(|w| w.parse::<f64>().ok().filter(|v| v.is_finite() && v.abs() <= f32::MAX as f64))
             .collect::<Option<Vec<f64>>>()
-            .ok_or_else(|| self.err(file, e, format!("'{s}' is not a list of finite numbers")))
+            .ok_or_else(|| {
+                self.err(file, e, format!("'{}' is not a list of finite numbers (of 32-bit float range)", clip(s, 80)))
+            })
     }
 
     /// `<point>`/`<vector>`: `x`/`y`/`z` attributes or a `value`.
@@ -270,7 +280,7 @@ impl Loader {
     fn texture(&mut self, file: &Path, t: &Element) -> Result<MatParam, SceneError> {
         let ty = self.attr(file, t, "type")?.unwrap_or_default();
         if ty != "bitmap" {
-            self.b.ignore(format!("<texture type=\"{ty}\"> (grey 0.5 used)"));
+            self.b.ignore_at(format!("<texture type=\"{}\"> (grey 0.5 used)", clip(&ty, 40)), at(file, t.line));
             return Ok(MatParam::Rgb(Vec3::splat(0.5)));
         }
         let mut filename = None;
@@ -293,14 +303,12 @@ impl Loader {
             }
         }
         let filename = filename.ok_or_else(|| self.err(file, t, "bitmap texture without a filename"))?;
-        let path = self.dir.join(filename);
+        let path = self.dir.resolve(&filename, file, t.line)?;
+        let referenced_by = at(file, t.line);
         if !path.is_file() {
-            return Err(SceneError::new(
-                &path,
-                format!("texture file not found (referenced by {}: line {})", file.display(), t.line),
-            ));
+            return Err(SceneError::new(&path, format!("texture file not found (referenced by {referenced_by})")));
         }
-        Ok(MatParam::Texture(TexDesc { file: path, uv, scale: Vec3::ONE, srgb: !raw }))
+        Ok(MatParam::Texture(TexDesc { file: path, uv, scale: Vec3::ONE, srgb: !raw, referenced_by }))
     }
 
     /// A `<bsdf>` (any nesting of `twosided`) as a description; returns its index.
@@ -329,7 +337,7 @@ impl Loader {
             }
         }
         let name = e.attr("id").map(str::to_string).unwrap_or_else(|| format!("{}:{}", file.display(), e.line));
-        Ok(self.b.add_desc(MaterialDesc { name, kind: ty, params }))
+        Ok(self.b.add_desc(MaterialDesc { name, kind: ty, params, at: at(file, e.line) }))
     }
 
     fn shape(&mut self, file: &Path, e: &Element) -> Result<(), SceneError> {
@@ -375,11 +383,11 @@ impl Loader {
         }
         let material =
             material.unwrap_or(if has_emitter { self.default_emitter_material } else { self.default_material });
-        let by = format!("{}: line {}", file.display(), e.line);
+        let by = at(file, e.line);
         let mesh: Option<ObjectMesh> = match ty.as_str() {
             "obj" | "ply" => {
                 let f = filename.ok_or_else(|| self.err(file, e, format!("{ty} shape without a filename")))?;
-                let path = self.dir.join(&f);
+                let path = self.dir.resolve(&f, file, e.line)?;
                 let bytes = read_bytes(&path, &by)?;
                 let m = if ty == "obj" {
                     crate::scene::obj::decode(&String::from_utf8_lossy(&bytes))
@@ -394,7 +402,7 @@ impl Loader {
             "disk" => Some(import_build::disk(1.0, 0.0, false)),
             "sphere" => None,
             other => {
-                self.b.ignore(format!("<shape type=\"{other}\">"));
+                self.b.ignore_at(format!("<shape type=\"{}\">", clip(other, 40)), at(file, e.line));
                 return Ok(());
             }
         };
@@ -412,19 +420,22 @@ impl Loader {
                     }
                 }
                 let det_flip = Mat3::from_mat4(world).determinant() < 0.0;
-                self.b.add_mesh(mesh, world, flip ^ det_flip, m);
+                self.b.add_mesh(mesh, world, flip ^ det_flip, m).map_err(|m| self.err(file, e, m))?;
             }
             None => {
                 if !(radius > 0.0) {
                     return Err(self.err(file, e, format!("sphere radius {radius} must be > 0")));
                 }
-                self.b.add_sphere(world * glam::Mat4::from_translation(center.as_vec3()), radius, m);
+                let to_world = world * glam::Mat4::from_translation(center.as_vec3());
+                self.b.add_sphere(to_world, radius, m).map_err(|m| self.err(file, e, m))?;
             }
         }
         self.b.count(&format!("{ty} shapes"), 1);
         Ok(())
     }
 
+    /// An emitter's radiance (or intensity, irradiance): finite and ≥ 0 in every channel, as Mitsuba 3 refuses a
+    /// negative emitter spectrum.
     fn radiance(&mut self, file: &Path, e: &Element, name: &str) -> Result<Vec3, SceneError> {
         let mut v = Vec3::ONE;
         for c in &e.children {
@@ -433,6 +444,13 @@ impl Loader {
                     Some((_, MatParam::Rgb(c))) => v = c,
                     Some((_, MatParam::Float(f))) => v = Vec3::splat(f),
                     _ => return Err(self.err(file, c, format!("'{name}' must be an rgb or spectrum value"))),
+                }
+                if !(v.min_element() >= 0.0 && v.is_finite()) {
+                    return Err(self.err(
+                        file,
+                        c,
+                        format!("'{name}' {v} is negative or not finite (emitted light is ≥ 0)"),
+                    ));
                 }
             }
         }
@@ -453,6 +471,9 @@ impl Loader {
         let ty = self.need(file, e, "type")?;
         let to_world = self.to_world(file, e)?;
         let scale = self.float_prop(file, e, "scale", 1.0)?;
+        if !(scale >= 0.0) {
+            return Err(self.err(file, e, format!("an emitter's 'scale' must be ≥ 0, not {scale}")));
+        }
         match ty.as_str() {
             "constant" => self.b.scene.environment = Environment::Constant(self.radiance(file, e, "radiance")? * scale),
             "envmap" => {
@@ -461,14 +482,12 @@ impl Loader {
                     .iter()
                     .find(|c| c.attr("name") == Some("filename"))
                     .ok_or_else(|| self.err(file, e, "envmap without a filename"))?;
-                let path = self.dir.join(self.need(file, f, "value")?);
-                let by = format!("{}: line {}", file.display(), e.line);
+                let path = self.dir.resolve(&self.need(file, f, "value")?, file, f.line)?;
+                let by = at(file, e.line);
                 let bytes = read_bytes(&path, &by)?;
-                let img = crate::scene::catch_quietly(|| image::load_from_memory(&bytes))
-                    .map_err(|p| SceneError::new(&path, format!("corrupt image (the decoder failed: {p})")))?
-                    .map_err(|er| {
-                        SceneError::new(&path, format!("cannot decode environment map: {er} (referenced by {by})"))
-                    })?
+                let format = image::guess_format(&bytes).unwrap_or(image::ImageFormat::Hdr);
+                let img = crate::scene::import_texture::decode_limited(&bytes, format)
+                    .map_err(|er| SceneError::new(&path, format!("{er} (referenced by {by})")))?
                     .to_rgb32f();
                 let texels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
                 // Mitsuba's lat-long (envmap.cpp): u = atan2(x, −z)/2π wrapped to [0, 1), v = acos(y)/π in its
@@ -519,7 +538,7 @@ impl Loader {
             }
             "area" => return Err(self.err(file, e, "an area emitter must be inside a <shape>")),
             other => {
-                self.b.ignore(format!("<emitter type=\"{other}\">"));
+                self.b.ignore_at(format!("<emitter type=\"{}\">", clip(other, 40)), at(file, e.line));
                 return Ok(());
             }
         }
@@ -530,9 +549,13 @@ impl Loader {
     fn sensor(&mut self, file: &Path, e: &Element) -> Result<(), SceneError> {
         let ty = self.need(file, e, "type")?;
         if ty != "perspective" {
-            self.b.ignore(format!("<sensor type=\"{ty}\"> (rendered as perspective)"));
+            self.b
+                .ignore_at(format!("<sensor type=\"{}\"> (rendered as perspective)", clip(&ty, 40)), at(file, e.line));
         }
         let to_world = self.to_world(file, e)?;
+        if !to_world.is_finite() || glam::DMat3::from_mat4(to_world).determinant() == 0.0 {
+            return Err(self.err(file, e, "the sensor's to_world is singular (determinant 0): it cannot be inverted"));
+        }
         let fov = self.float_prop(file, e, "fov", 90.0)? as f64;
         if !(fov > 0.0 && fov < 180.0) {
             return Err(self.err(file, e, format!("fov {fov} is outside (0, 180) degrees")));

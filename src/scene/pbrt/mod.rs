@@ -8,10 +8,15 @@ mod parser;
 mod shapes;
 mod tokenizer;
 
-use super::{Scene, SceneError};
+use super::{LoadOptions, Scene, SceneError};
 use std::path::Path;
 
-/// Loads a `.pbrt` file (and what it includes).
+/// Loads a `.pbrt` file (and what it includes) with the default options.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    parser::Parser::new(path).run()
+    load_with(path, &LoadOptions::default())
+}
+
+/// Loads a `.pbrt` file; `options.allow_outside_paths` lets its file names leave its folder.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
+    parser::Parser::new(path, options).run()
 }

@@ -73,10 +73,15 @@ pub fn parse(file: &Path, line: usize, tokens: &[Token], i: &mut usize) -> Resul
         let pline = t.line;
         let mut parts = decl.split_whitespace();
         let (Some(ty), Some(name), None) = (parts.next(), parts.next(), parts.next()) else {
+            let decl = crate::io::input_file::clip(decl, 60);
             return Err(err(pline, format!("expected a parameter declaration \"type name\", found \"{decl}\"")));
         };
         if !TYPES.contains(&ty) {
-            return Err(err(pline, format!("unknown parameter type '{ty}' in \"{decl}\"")));
+            let decl = crate::io::input_file::clip(decl, 60);
+            return Err(err(
+                pline,
+                format!("unknown parameter type '{}' in \"{decl}\"", crate::io::input_file::clip(ty, 30)),
+            ));
         }
         *i += 1;
         let mut raw = Vec::new();
@@ -109,6 +114,15 @@ pub fn parse(file: &Path, line: usize, tokens: &[Token], i: &mut usize) -> Resul
             _ => return Err(err(pline, format!("parameter \"{decl}\" has no value"))),
         }
         let values = convert(ty, &raw).map_err(|m| err(pline, format!("parameter \"{decl}\": {m}")))?;
+        if let (Values::Nums(v), "rgb" | "color") = (&values, ty) {
+            // pbrt-v4 refuses every negative RGB value (paramdict.cpp): no spectrum, reflectance or light is negative.
+            if let Some(x) = v.iter().find(|x| **x < 0.0) {
+                return Err(err(
+                    pline,
+                    format!("parameter \"{decl}\": negative RGB component {x} (pbrt-v4 refuses it)"),
+                ));
+            }
+        }
         list.push(Param { ty: ty.into(), name: name.into(), values, line: pline, used: Cell::new(false) });
     }
     Ok(Params { file: file.to_path_buf(), line, list })

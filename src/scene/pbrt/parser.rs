@@ -1,15 +1,22 @@
 //! pbrt-v4 directives and graphics state: transforms, attribute stacks, named materials and textures, area
 //! lights, object instancing (flattened into triangles), Include/Import (with circular-include detection),
 //! camera, film and lights.
+//!
+//! pbrt-v4's own rules are kept, with an error naming the file and line where pbrt-v4 refuses a scene (its
+//! `VERIFY_OPTIONS` / `VERIFY_WORLD`: options after `WorldBegin`, scene description before it, a second
+//! `WorldBegin`; negative RGB values; unknown camera and film types; unknown named spectra), and a warning where
+//! pbrt-v4 renders and mislab approximates. File names (Include, textures, meshes, maps) must stay inside the
+//! scene's folder unless `--allow-outside-paths` (`read_input::SceneDir`).
 
 use super::params::{self, Params};
 use super::shapes;
 use super::tokenizer::{tokenize, Tok, Token};
+use crate::io::input_file::clip;
 use crate::scene::env_import::{self, Layout};
 use crate::scene::import_build::{Builder, ObjectMesh};
 use crate::scene::import_material::{MatParam, MaterialDesc};
-use crate::scene::read_input::read_bytes;
-use crate::scene::{Camera, Environment, PunctualLight, Scene, SceneError};
+use crate::scene::read_input::{at, included_from, read_bytes, SceneDir};
+use crate::scene::{Camera, Environment, LoadOptions, PunctualLight, Scene, SceneError};
 use glam::{DMat4, DVec3, Mat3, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -64,10 +71,38 @@ enum Scope {
     Object,
 }
 
+/// Directives pbrt-v4 takes only before `WorldBegin` (its `VERIFY_OPTIONS`).
+const OPTIONS_ONLY: &[&str] =
+    &["Camera", "Sampler", "Film", "PixelFilter", "Accelerator", "Integrator", "TransformTimes", "WorldBegin"];
+/// Directives pbrt-v4 takes only after `WorldBegin` (its `VERIFY_WORLD`; TransformBegin/End are its
+/// AttributeBegin/End).
+const WORLD_ONLY: &[&str] = &[
+    "ReverseOrientation",
+    "AttributeBegin",
+    "AttributeEnd",
+    "TransformBegin",
+    "TransformEnd",
+    "LightSource",
+    "Shape",
+    "ObjectBegin",
+    "ObjectEnd",
+    "ObjectInstance",
+    "Texture",
+    "Material",
+    "MakeNamedMaterial",
+    "NamedMaterial",
+    "AreaLightSource",
+];
+/// pbrt-v4's camera and film types (others are an error there).
+const CAMERAS: &[&str] = &["perspective", "orthographic", "realistic", "spherical"];
+const FILMS: &[&str] = &["rgb", "gbuffer", "spectral"];
+
 /// The parser and everything it has built so far.
 pub struct Parser {
     main: PathBuf,
-    dir: PathBuf,
+    dir: SceneDir,
+    /// Where `WorldBegin` was, once it was.
+    world: Option<String>,
     b: Builder,
     gs: State,
     stack: Vec<(State, Scope, PathBuf, usize)>,
@@ -84,17 +119,20 @@ pub struct Parser {
 }
 
 impl Parser {
-    /// A parser for the file at `main` (relative paths in it resolve against its directory, as in pbrt).
-    pub fn new(main: &Path) -> Parser {
+    /// A parser for the file at `main` (relative paths in it resolve against its directory, as in pbrt, and may
+    /// leave it only with `options.allow_outside_paths`).
+    pub fn new(main: &Path, options: &LoadOptions) -> Parser {
         let mut b = Builder::default();
         let default = b.add_desc(MaterialDesc {
             name: "pbrt default (diffuse 0.5)".into(),
             kind: "diffuse".into(),
             params: Default::default(),
+            at: String::new(),
         });
         Parser {
             main: main.to_path_buf(),
-            dir: main.parent().map(Path::to_path_buf).unwrap_or_default(),
+            dir: SceneDir::of(main, options.allow_outside_paths),
+            world: None,
             b,
             gs: State { ctm: DMat4::IDENTITY, reverse: false, material: default, area: None },
             stack: vec![],
@@ -122,16 +160,30 @@ impl Parser {
             };
             return Err(SceneError::new(file, format!("line {line}: {what} is never closed (is the file truncated?)")));
         }
+        if self.world.is_none() {
+            // pbrt-v4: "End of files before WorldBegin".
+            return Err(SceneError::new(
+                &main,
+                "the file ends before WorldBegin: a pbrt-v4 scene describes its world after WorldBegin",
+            ));
+        }
         let [w, h] = self.film;
         let mut scene_camera = Camera::default();
         if let Some((camera_from_world, fov)) = self.camera {
             let wfc = self.mirror * camera_from_world.inverse();
+            let finite = |v: Vec3| v.is_finite();
             let position = wfc.transform_point3(DVec3::ZERO).as_vec3();
             let forward = wfc.transform_vector3(DVec3::Z).normalize().as_vec3();
             let up = wfc.transform_vector3(DVec3::Y).normalize().as_vec3();
             // pbrt's fov spans the shorter image axis; ours is vertical.
             let half = (fov.to_radians() / 2.0).tan();
             let vfov = if w >= h { fov.to_radians() } else { 2.0 * (half * h as f64 / w as f64).atan() };
+            if !(finite(position) && finite(forward) && finite(up)) {
+                return Err(SceneError::new(
+                    &main,
+                    "the camera's position or direction is out of the range of 32-bit floats",
+                ));
+            }
             scene_camera = Camera { position, forward, up, vfov: vfov as f32 };
             self.b.count("camera (perspective)", 1);
         } else {
@@ -160,9 +212,11 @@ impl Parser {
                 format!("not UTF-8 text (byte {}): is this a pbrt file?", e.utf8_error().valid_up_to()),
             )
         })?;
-        let tokens = tokenize(path, &text)?;
+        // An error in an included file names that file and line, and where it was included from.
+        let placed = |e| included_from(path, by, e);
+        let tokens = tokenize(path, &text).map_err(placed)?;
         self.includes.push(canonical);
-        let r = self.tokens(path, &tokens);
+        let r = self.tokens(path, &tokens).map_err(placed);
         self.includes.pop();
         r
     }
@@ -173,10 +227,27 @@ impl Parser {
             let line = t[i].line;
             let err = |m: String| SceneError::new(file, format!("line {line}: {m}"));
             let Tok::Word(d) = &t[i].tok else {
-                return Err(err(format!("expected a directive, found {:?}", t[i].tok)));
+                // What was found, not its text: a file that is not pbrt at all is not echoed.
+                let found = match &t[i].tok {
+                    Tok::Str(_) => "a quoted string",
+                    Tok::Num(_) => "a number",
+                    _ => "a bracket",
+                };
+                return Err(err(format!("expected a directive, found {found}")));
             };
             let d = d.clone();
             i += 1;
+            if self.world.is_some() && OPTIONS_ONLY.contains(&d.as_str()) {
+                let first = self.world.as_deref().unwrap_or("");
+                return Err(err(if d == "WorldBegin" {
+                    format!("a second WorldBegin (the first is at {first})")
+                } else {
+                    format!("{d} after WorldBegin (at {first}): pbrt-v4 takes it only before WorldBegin")
+                }));
+            }
+            if self.world.is_none() && WORLD_ONLY.contains(&d.as_str()) {
+                return Err(err(format!("{d} before WorldBegin: pbrt-v4 takes it only after WorldBegin")));
+            }
             let nums = |n: usize, i: &mut usize| -> Result<Vec<f64>, SceneError> {
                 let bracket = matches!(t.get(*i).map(|t| &t.tok), Some(Tok::Open));
                 if bracket {
@@ -223,7 +294,10 @@ impl Parser {
                         _ => return Err(err(format!("{d} without a matching {}Begin", &d[..d.len() - 3]))),
                     }
                 }
-                "WorldBegin" => self.gs.ctm = DMat4::IDENTITY,
+                "WorldBegin" => {
+                    self.gs.ctm = DMat4::IDENTITY;
+                    self.world = Some(at(file, line));
+                }
                 "WorldEnd" => {}
                 "Identity" => self.gs.ctm = DMat4::IDENTITY,
                 "Translate" => {
@@ -258,8 +332,8 @@ impl Parser {
                 "ReverseOrientation" => self.gs.reverse = !self.gs.reverse,
                 "Include" | "Import" => {
                     let name = string(&mut i)?;
-                    let path = self.dir.join(&name);
-                    self.file(&path, &format!("{}: line {line}", file.display()))?;
+                    let path = self.dir.resolve(&name, file, line)?;
+                    self.file(&path, &at(file, line))?;
                 }
                 "ObjectBegin" => {
                     let name = string(&mut i)?;
@@ -281,6 +355,9 @@ impl Parser {
                 }
                 "ObjectInstance" => {
                     let name = string(&mut i)?;
+                    if self.object.is_some() {
+                        return Err(err("ObjectInstance inside an object definition (ObjectBegin)".into()));
+                    }
                     let Some(shapes) = self.objects.get(&name).cloned() else {
                         return Err(err(format!("ObjectInstance \"{name}\": no such object (ObjectBegin)")));
                     };
@@ -326,8 +403,19 @@ impl Parser {
     ) -> Result<(), SceneError> {
         match d {
             "Camera" => {
+                if !CAMERAS.contains(&kind) {
+                    return Err(p.error(format!(
+                        "unknown camera type \"{}\" (pbrt-v4 has {})",
+                        clip(kind, 40),
+                        CAMERAS.join(", ")
+                    )));
+                }
                 if kind != "perspective" {
-                    self.b.ignore(format!("Camera \"{kind}\" (rendered as perspective)"));
+                    self.b.ignore_at(format!("Camera \"{kind}\" (rendered as perspective)"), at(&p.file, p.line));
+                }
+                let m = self.gs.ctm;
+                if !m.is_finite() || glam::DMat3::from_mat4(m).determinant() == 0.0 {
+                    return Err(p.error("the camera's transform is singular (determinant 0): it cannot be inverted"));
                 }
                 let fov = p.float("fov", 90.0)? as f64;
                 if !(fov > 0.0 && fov < 180.0) {
@@ -338,6 +426,13 @@ impl Parser {
                 self.mirror = if proper { MIRROR_X } else { DMat4::IDENTITY };
             }
             "Film" => {
+                if !FILMS.contains(&kind) {
+                    return Err(p.error(format!(
+                        "unknown film type \"{}\" (pbrt-v4 has {})",
+                        clip(kind, 40),
+                        FILMS.join(", ")
+                    )));
+                }
                 let (w, h) = (p.int("xresolution", 1280)?, p.int("yresolution", 720)?);
                 if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
                     return Err(p.error(format!("Film resolution {w}x{h} is out of range (1..=16384 per side)")));
@@ -366,11 +461,14 @@ impl Parser {
             }
             "AreaLightSource" => {
                 if kind != "diffuse" {
-                    self.b.ignore(format!("AreaLightSource \"{kind}\""));
+                    self.b.ignore_at(format!("AreaLightSource \"{}\"", clip(kind, 40)), at(&p.file, p.line));
                 } else {
                     let l = self.spectrum(&p, "L", Vec3::ONE)?;
-                    let scale = p.float("scale", 1.0)?;
+                    let scale = light_scale(&p)?;
                     let two_sided = p.bool("twosided", false)?;
+                    if !(l * scale).is_finite() {
+                        return Err(p.error("the area light's radiance × scale is out of the range of 32-bit floats"));
+                    }
                     self.gs.area = Some(AreaLight { radiance: l * scale, two_sided });
                 }
             }
@@ -401,7 +499,7 @@ impl Parser {
                 }
                 return Ok(());
             }
-            _ => return Err(p.error(format!("unknown directive '{d}'"))),
+            _ => return Err(p.error(format!("unknown directive '{}'", clip(d, 40)))),
         }
         for u in p.unused() {
             self.b.ignore(format!("{d} \"{kind}\" parameter {u}"));
@@ -411,7 +509,10 @@ impl Parser {
 
     fn light(&mut self, kind: &str, p: &Params) -> Result<(), SceneError> {
         let to_world = self.mirror * self.gs.ctm;
-        let scale = p.float("scale", 1.0)?;
+        if !to_world.is_finite() || glam::DMat3::from_mat4(to_world).determinant() == 0.0 {
+            return Err(p.error("the light's transform is singular (determinant 0)"));
+        }
+        let scale = light_scale(p)?;
         if p.has("power") || p.has("illuminance") {
             self.b.ignore(format!("LightSource \"{kind}\" \"power\"/\"illuminance\" (scale and L/I are used)"));
         }
@@ -460,8 +561,8 @@ impl Parser {
                 }
                 let light_from_world = Mat3::from_mat4(to_world.as_mat4()).inverse();
                 if let Some(file) = p.string("filename")? {
-                    let path = self.dir.join(&file);
-                    let by = format!("{}: line {}", p.file.display(), p.line);
+                    let path = self.dir.resolve(&file, &p.file, p.line)?;
+                    let by = at(&p.file, p.line);
                     let (w, h, texels) = load_float_image(&path, &by)?;
                     if w != h {
                         self.b.ignore("a non-square infinite light map (read as lat-long)");
@@ -477,12 +578,15 @@ impl Parser {
                 p.has("portal");
             }
             _ => {
-                self.b.ignore(format!("LightSource \"{kind}\""));
+                self.b.ignore_at(format!("LightSource \"{}\"", clip(kind, 40)), at(&p.file, p.line));
                 for u in p.unused() {
                     p.has(u.trim_matches('"').split(' ').nth(1).unwrap_or(""));
                 }
                 return Ok(());
             }
+        }
+        if !lights_are_finite(&self.b.scene) {
+            return Err(p.error("the light's intensity, position or direction is out of the range of 32-bit floats"));
         }
         self.b.count(&format!("{kind} lights"), 1);
         Ok(())
@@ -501,8 +605,8 @@ impl Parser {
                         if t.uv != [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
                             self.b.ignore("uscale/vscale/udelta/vdelta of alpha textures (the mask uses the mesh uv)");
                         }
-                        let file = t.file.clone();
-                        mask = Some(self.b.alpha_mask(&file)?);
+                        let (file, by) = (t.file.clone(), t.referenced_by.clone());
+                        mask = Some(self.b.alpha_mask(&file, &by)?);
                     }
                     Some(_) => self.b.ignore("non-image alpha textures (opaque)"),
                     None => return Err(p.error(format!("\"texture alpha\" \"{name}\": no such texture"))),
@@ -533,7 +637,7 @@ impl Parser {
             }
             "sphere" => None,
             other => {
-                self.b.ignore(format!("Shape \"{other}\""));
+                self.b.ignore_at(format!("Shape \"{}\"", clip(other, 40)), at(&p.file, p.line));
                 return Ok(());
             }
         };
@@ -551,7 +655,7 @@ impl Parser {
             None => material,
         };
         match mesh {
-            Some(m) => self.b.add_mesh(m, to_world, flip, material),
+            Some(m) => self.b.add_mesh(m, to_world, flip, material).map_err(|e| p.error(e))?,
             None => {
                 let radius = p.float("radius", 1.0)?;
                 if !(radius > 0.0) {
@@ -563,7 +667,7 @@ impl Parser {
                 if s.reverse && s.area.is_some() {
                     self.b.ignore("ReverseOrientation on sphere emitters (they emit outwards)");
                 }
-                self.b.add_sphere(to_world, radius, material);
+                self.b.add_sphere(to_world, radius, material).map_err(|e| p.error(e))?;
             }
         }
         self.b.count(&format!("{} shapes", s.kind), 1);
@@ -572,6 +676,22 @@ impl Parser {
         }
         Ok(())
     }
+}
+
+/// Whether every punctual light and the constant environment are finite (the importers check each light as
+/// they add it, so a failure is the last one's).
+fn lights_are_finite(scene: &Scene) -> bool {
+    scene.punctual_lights.iter().all(crate::scene::punctual_light_is_finite)
+        && !matches!(scene.environment, Environment::Constant(c) if !c.is_finite())
+}
+
+/// A light's `"float scale"`: finite and ≥ 0 (a negative one would make a light that absorbs).
+fn light_scale(p: &Params) -> Result<f32, SceneError> {
+    let scale = p.float("scale", 1.0)?;
+    if !(scale >= 0.0 && scale.is_finite()) {
+        return Err(p.error(format!("a light's \"scale\" must be a finite number ≥ 0, not {scale}")));
+    }
+    Ok(scale)
 }
 
 /// pbrt's LookAt (camera-from-world): x = up × dir, y = dir × x, z = dir.
@@ -589,15 +709,15 @@ fn load_float_image(path: &Path, by: &str) -> Result<(u32, u32, Vec<[f32; 3]>), 
     let bytes = read_bytes(path, by)?;
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     let bad = |m: String| SceneError::new(path, format!("{m} (referenced by {by})"));
-    match ext.as_str() {
-        "pfm" => crate::scene::pfm::decode(&bytes).map(|p| (p.width, p.height, p.texels)).map_err(bad),
-        "exr" | "hdr" => {
-            let img = crate::scene::catch_quietly(|| image::load_from_memory(&bytes))
-                .map_err(|e| bad(format!("corrupt image (the decoder failed: {e})")))?
-                .map_err(|e| bad(format!("cannot decode image: {e}")))?
-                .to_rgb32f();
-            Ok((img.width(), img.height(), img.pixels().map(|p| p.0).collect()))
+    let format = match ext.as_str() {
+        "pfm" => return crate::scene::pfm::decode(&bytes).map(|p| (p.width, p.height, p.texels)).map_err(bad),
+        "exr" => image::ImageFormat::OpenExr,
+        "hdr" => image::ImageFormat::Hdr,
+        _ => {
+            let ext = clip(&ext, 20);
+            return Err(bad(format!("unsupported environment map format '.{ext}' (expected .pfm, .exr or .hdr)")));
         }
-        _ => Err(bad(format!("unsupported environment map format '.{ext}' (expected .pfm or .exr)"))),
-    }
+    };
+    let img = crate::scene::import_texture::decode_limited(&bytes, format).map_err(bad)?.to_rgb32f();
+    Ok((img.width(), img.height(), img.pixels().map(|p| p.0).collect()))
 }

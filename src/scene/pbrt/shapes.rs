@@ -3,10 +3,9 @@
 
 use super::params::Params;
 use crate::scene::import_build::ObjectMesh;
-use crate::scene::read_input::read_bytes;
+use crate::scene::read_input::{at, read_bytes, SceneDir};
 use crate::scene::SceneError;
 use glam::{Vec2, Vec3};
-use std::path::Path;
 
 fn vec3s(v: Vec<f64>) -> Vec<Vec3> {
     v.chunks_exact(3).map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)).collect()
@@ -48,11 +47,11 @@ pub fn inline_mesh(p: &Params, name: &str, bilinear: bool) -> Result<ObjectMesh,
     Ok(ObjectMesh { name: name.into(), positions, normals, uvs, indices })
 }
 
-/// `plymesh`: the file named by `"string filename"`, relative to `dir`.
-pub fn ply_mesh(p: &Params, dir: &Path) -> Result<ObjectMesh, SceneError> {
+/// `plymesh`: the file named by `"string filename"`, relative to the scene's folder (and inside it, unless allowed).
+pub fn ply_mesh(p: &Params, dir: &SceneDir) -> Result<ObjectMesh, SceneError> {
     let file = p.string("filename")?.ok_or_else(|| p.error("plymesh: no \"string filename\""))?;
-    let path = dir.join(&file);
-    let by = format!("{}: line {}", p.file.display(), p.line);
+    let path = dir.resolve(&file, &p.file, p.line)?;
+    let by = at(&p.file, p.line);
     let bytes = read_bytes(&path, &by)?;
     let m =
         crate::scene::ply::decode(&bytes).map_err(|e| SceneError::new(&path, format!("{e} (referenced by {by})")))?;

@@ -79,16 +79,32 @@ pub fn tokenize(path: &Path, text: &str) -> Result<Vec<Token>, SceneError> {
                 }
                 let word = &text[start..i];
                 let first = word.as_bytes()[0];
+                // Messages show a bad word only when it is short and number-like: a file that is not pbrt text
+                // (an Include of something else) is never echoed.
+                let shown = |w: &str| {
+                    if w.len() <= 24 && w.bytes().all(|b| b.is_ascii_alphanumeric() || b"+-.".contains(&b)) {
+                        format!("'{w}' ")
+                    } else {
+                        String::new()
+                    }
+                };
                 if first.is_ascii_digit() || matches!(first, b'-' | b'+' | b'.') {
-                    let v: f64 = word.parse().map_err(|_| err(line, format!("'{word}' is not a number")))?;
-                    if !v.is_finite() {
-                        return Err(err(line, format!("'{word}' is not a finite number")));
+                    let v: f64 = word.parse().map_err(|_| err(line, format!("{}is not a number", shown(word))))?;
+                    // pbrt-v4 reads its numbers as 32-bit floats: 1e39 is no number there, and an infinity here
+                    // would reach the renderer (and a baked shader) as a literal.
+                    if !(v.is_finite() && v.abs() <= f32::MAX as f64) {
+                        return Err(err(
+                            line,
+                            format!("{}is out of the range of 32-bit floats (±3.4e38)", shown(word)),
+                        ));
                     }
                     out.push(Token { tok: Tok::Num(v), line });
-                } else if first.is_ascii_alphabetic() {
+                } else if first.is_ascii_alphabetic() && word.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
                     out.push(Token { tok: Tok::Word(word.to_string()), line });
                 } else {
-                    return Err(err(line, format!("unexpected character in '{word}'")));
+                    let c = word.chars().find(|c| !(c.is_ascii_alphanumeric() || *c == '_')).unwrap_or('?');
+                    let c = if c.is_ascii_graphic() { format!("'{c}'") } else { format!("U+{:04X}", c as u32) };
+                    return Err(err(line, format!("unexpected character {c} (not pbrt-v4 text?)")));
                 }
             }
         }

@@ -2,8 +2,10 @@
 //! textures, RGB-valued parameters, and a `Material`'s typed parameter list with its textures resolved.
 
 use super::Parser;
+use crate::io::input_file::clip;
 use crate::scene::import_material::{MatParam, MaterialDesc, TexDesc};
 use crate::scene::pbrt::params::{Params, Values};
+use crate::scene::read_input::at;
 use crate::scene::SceneError;
 use glam::Vec3;
 
@@ -13,6 +15,11 @@ impl Parser {
         match p.type_of(name) {
             Some("rgb") | Some("color") => Ok(p.vec3(name, &["rgb", "color"])?.unwrap_or(default)),
             Some(ty) => {
+                if let Some(q) = p.list.iter().rev().find(|q| q.name == name) {
+                    if let Values::Strs(s) = &q.values {
+                        self.named_spectrum(p, q.line, s.first().map_or("", String::as_str))?;
+                    }
+                }
                 p.has(name);
                 self.b.ignore(format!("\"{ty} {name}\" spectra (white of the same luminance 1 used)"));
                 Ok(Vec3::ONE)
@@ -21,17 +28,39 @@ impl Parser {
         }
     }
 
+    /// A `"spectrum"` parameter's name: one of pbrt-v4's named spectra, or a spectrum file in the scene's folder
+    /// (whose values mislab does not read: the caller approximates and says so). Anything else is an error at
+    /// `line`, as pbrt-v4 refuses it.
+    pub(super) fn named_spectrum(&mut self, p: &Params, line: usize, name: &str) -> Result<(), SceneError> {
+        if crate::scene::named_spectra::is_pbrt_name(name) {
+            return Ok(());
+        }
+        let file = self.dir.resolve(name, &p.file, line)?;
+        if file.is_file() {
+            self.b.ignore_at(format!("spectrum file \"{}\" (white used)", clip(name, 60)), at(&p.file, line));
+            return Ok(());
+        }
+        Err(SceneError::new(
+            &p.file,
+            format!(
+                "line {line}: unknown named spectrum \"{}\" (neither one of pbrt-v4's named spectra nor a spectrum file)",
+                clip(name, 60)
+            ),
+        ))
+    }
+
     pub(super) fn texture(&mut self, name: &str, _ty: &str, class: &str, p: &Params) -> Result<(), SceneError> {
         let value = match class {
             "imagemap" => {
                 let file = p
                     .string("filename")?
                     .ok_or_else(|| p.error(format!("Texture \"{name}\": no \"string filename\"")))?;
-                let path = self.dir.join(&file);
+                let path = self.dir.resolve(&file, &p.file, p.line)?;
+                let referenced_by = at(&p.file, p.line);
                 if !path.is_file() {
                     return Err(SceneError::new(
                         &path,
-                        format!("texture file not found (referenced by {}: line {})", p.file.display(), p.line),
+                        format!("texture file not found (referenced by {referenced_by})"),
                     ));
                 }
                 let (us, vs) = (p.float("uscale", 1.0)?, p.float("vscale", 1.0)?);
@@ -45,7 +74,13 @@ impl Parser {
                 // Stored with v down; our add_mesh already flips v, so the pbrt map (us·u+ud, vs·v+vd) becomes
                 // u' = us·u + ud, v' = vs·v' − vs + 1 − vd in terms of the flipped v' = 1 − v.
                 let uv = [[us, 0.0, ud], [0.0, vs, 1.0 - vs - vd]];
-                MatParam::Texture(TexDesc { file: path, uv, scale: Vec3::splat(scale), srgb: encoding != "linear" })
+                MatParam::Texture(TexDesc {
+                    file: path,
+                    uv,
+                    scale: Vec3::splat(scale),
+                    srgb: encoding != "linear",
+                    referenced_by,
+                })
             }
             "scale" => {
                 let base = self.texture_or_value(p, "tex", Vec3::ONE)?;
@@ -73,7 +108,7 @@ impl Parser {
             "constant" => self.texture_or_value(p, "value", Vec3::ONE)?,
             "checkerboard" => self.checkerboard(name, p)?,
             _ => {
-                self.b.ignore(format!("Texture class \"{class}\" (grey 0.5 used)"));
+                self.b.ignore_at(format!("Texture class \"{}\" (grey 0.5 used)", clip(class, 40)), at(&p.file, p.line));
                 MatParam::Rgb(Vec3::splat(0.5))
             }
         };
@@ -142,7 +177,10 @@ impl Parser {
                 ("rgb" | "color", Values::Nums(v)) if v.len() == 3 => {
                     MatParam::Rgb(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
                 }
-                ("spectrum", Values::Strs(s)) if s.len() == 1 => MatParam::Spectrum(s[0].clone()),
+                ("spectrum", Values::Strs(s)) if s.len() == 1 => {
+                    self.named_spectrum(p, q.line, &s[0])?;
+                    MatParam::Spectrum(s[0].clone())
+                }
                 ("spectrum" | "blackbody", Values::Nums(_)) => MatParam::Spectrum(format!("{} values", q.ty)),
                 ("string", Values::Strs(s)) if s.len() == 1 => MatParam::Str(s[0].clone()),
                 ("bool", Values::Bools(b)) if b.len() == 1 => MatParam::Bool(b[0]),
@@ -150,6 +188,6 @@ impl Parser {
             };
             params.insert(q.name.clone(), v);
         }
-        Ok(MaterialDesc { name: name.into(), kind: kind.into(), params })
+        Ok(MaterialDesc { name: name.into(), kind: kind.into(), params, at: at(&p.file, p.line) })
     }
 }
