@@ -211,7 +211,10 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     eprintln!("adapter: {}", lab.adapter());
     eprintln!("scene: {}", scene.summary());
     let t_device = Instant::now();
-    let (settings, _) = job.settings_for(&scene);
+    for note in job.resolve(&scene) {
+        eprintln!("note: {note}");
+    }
+    let settings = job.settings.clone();
     // Hidden until start-up is over (`CliObserver::started`).
     let length = match job.budget {
         api::Budget::Samples(n) => n as u64,

@@ -92,3 +92,44 @@ fn a_render_in_steps_is_the_render_at_once_bit_for_bit_and_pipelines_are_kept() 
     let bits = |i: &api::Image| i.mean().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&whole), bits(&steps));
 }
+
+/// The Bitterli scenes beside the crate (`../shared`).
+fn bitterli(rel: &str) -> String {
+    format!("{}/../shared/testdata/scenes/bitterli/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
+    use mislab::render::settings::Mode;
+    // pbrt-v4: `Integrator "volpath" "integer maxdepth" [65]`, `Sampler "sobol" "integer pixelsamples" [1]`, Film.
+    let stairs = SceneHandle::named(&bitterli("staircase2/pbrt-v4/scene-v4.pbrt")).unwrap();
+    let f = &stairs.scene().file_settings;
+    assert_eq!(f.max_depth.as_ref().map(|m| m.0), Some(65));
+    assert!(f.max_depth.as_ref().unwrap().1.contains("scene-v4.pbrt: line 1"), "{f:?}");
+    assert_eq!(f.spp.as_ref().map(|s| s.0), Some(1));
+    let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
+    let notes = j.resolve(&stairs);
+    assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 65, Budget::Samples(1)));
+    assert_eq!([j.settings.width, j.settings.height], stairs.film_size().unwrap());
+    assert_eq!(notes.len(), 3, "{notes:?}");
+    assert!(notes.iter().any(|n| n.contains("--max-depth 65") && n.contains("Integrator \"volpath\"")), "{notes:?}");
+    // Flags given win, each on its own.
+    let mut j = Job::from_pairs(&[("max_depth", "17"), ("spp", "8"), ("width", "64")]).unwrap();
+    j.resolve(&stairs);
+    assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 17, Budget::Samples(8)));
+    assert_eq!(j.settings.width, 64);
+    let mut j = Job::from_pairs(&[("mode", "direct")]).unwrap();
+    j.resolve(&stairs);
+    assert_eq!(j.settings.mode, Mode::Direct);
+    // The same flag at its default value is still a flag given: --mode direct is what was asked.
+    // Mitsuba 3: `<integrator type="path">` with max_depth 65 (vertices: 64 bounces), `<sampler>` sample_count 64.
+    let cornell = SceneHandle::named(&bitterli("cornell-box/mitsuba3/scene_v3.xml")).unwrap();
+    let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
+    j.resolve(&cornell);
+    assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 64, Budget::Samples(64)));
+    // A built-in scene states nothing: the flags' defaults stand.
+    let veach = SceneHandle::named("veach-mis").unwrap();
+    let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
+    assert!(j.resolve(&veach).is_empty());
+    assert_eq!((j.settings.mode, j.budget), (Mode::Direct, Budget::Samples(api::DEFAULT_SPP)));
+}

@@ -234,6 +234,10 @@ impl PyProgressive {
     #[new]
     fn new(py: Python<'_>, scene: &PyScene, flags: Vec<(String, String)>) -> PyResult<PyProgressive> {
         let mut job = job_of(&flags, false)?;
+        let mut observer = PyObserver { interrupted: false };
+        for note in job.resolve(&scene.inner) {
+            observer.note(&format!("note: {note}"));
+        }
         let total = match job.budget {
             Budget::Samples(n) => n,
             Budget::Time(_) => return Err(PyValueError::new_err("render_progressive takes spp=, not time=")),
@@ -242,7 +246,6 @@ impl PyProgressive {
             return Err(PyValueError::new_err("render_progressive does not write state files: use render()"));
         }
         let lab = lab()?;
-        let mut observer = PyObserver { interrupted: false };
         let render = py.detach(|| api::Render::begin(&lab, &scene.inner, &mut job, &mut observer)).map_err(py_err)?;
         Ok(PyProgressive { lab, render: Some(render), total, done: 0, submit_seconds: job.submit_seconds })
     }

@@ -5,14 +5,14 @@ use super::budget::Budget;
 use super::error::ApiError;
 use super::flags::RenderFlags;
 use super::scene::SceneHandle;
-use crate::render::settings::Settings;
+use crate::render::settings::{Mode, Settings};
 use crate::state::session::Session;
 use crate::state::StateHeader;
 use std::path::Path;
 
 /// A render to do: the settings, the budget, and the state file it resumes from and writes, if any.
 pub struct Job {
-    /// The settings asked for (the film size may still come from the scene: `settings_for`).
+    /// The settings asked for (the scene file's own may still fill those not given: `resolve`).
     pub settings: Settings,
     /// When to stop.
     pub budget: Budget,
@@ -26,6 +26,12 @@ pub struct Job {
     /// Samples per pixel in one dispatch instead of the renderer's safe default for the mode.
     pub dispatch_spp: Option<u32>,
     pub(crate) session: Option<Session>,
+    /// The flags given explicitly, where known (`RenderFlags::given`); None: a value equal to its default was not.
+    given: Option<Vec<String>>,
+    /// Whether the scene file's settings may fill the flags not given (not for the lab's own jobs).
+    file_defaults: bool,
+    /// Whether `resolve` has run.
+    resolved: bool,
 }
 
 impl Job {
@@ -47,6 +53,19 @@ impl Job {
             verify_complete: false,
             submit_seconds: super::drive::TARGET_SUBMIT_SECONDS,
             dispatch_spp: None,
+            given: flags.given.clone().or_else(|| {
+                // Without the front end's list: spp and time count as given when set.
+                Some(
+                    [("spp", flags.spp.is_some()), ("time", flags.time.is_some())]
+                        .iter()
+                        .filter(|(_, set)| *set)
+                        .map(|(n, _)| n.to_string())
+                        .chain(non_default_settings(&flags.settings))
+                        .collect(),
+                )
+            }),
+            file_defaults: true,
+            resolved: false,
             session,
         })
     }
@@ -62,6 +81,9 @@ impl Job {
             submit_seconds: super::drive::TARGET_SUBMIT_SECONDS,
             dispatch_spp: None,
             session: None,
+            given: None,
+            file_defaults: false,
+            resolved: false,
         })
     }
 
@@ -70,18 +92,43 @@ impl Job {
         Job::new(&RenderFlags::from_pairs(pairs)?, None)
     }
 
-    /// The settings for `scene`: the scene file's image size (pbrt `Film`, Mitsuba `hdrfilm`) where the width and
-    /// height were both left at their defaults, with a note saying so.
-    pub fn settings_for(&self, scene: &SceneHandle) -> (Settings, Option<String>) {
-        let mut settings = self.settings.clone();
-        let default = Settings::default();
-        match scene.film_size() {
-            Some([w, h]) if settings.width == default.width && settings.height == default.height => {
-                (settings.width, settings.height) = (w, h);
-                (settings, Some(format!("image size {w}x{h} from the scene file (--width/--height override it)")))
-            }
-            _ => (settings, None),
+    /// Takes the scene file's own settings where the flags did not give them: its image size (pbrt `Film`,
+    /// Mitsuba `hdrfilm`), path tracing and its depth (pbrt `Integrator`, Mitsuba `<integrator>`), its sample count
+    /// (pbrt `Sampler`, Mitsuba `<sampler>`). Returns a note per setting taken, saying where it came from. Runs once
+    /// (`Render::begin` calls it; a front end may call it first to see the settings).
+    pub fn resolve(&mut self, scene: &SceneHandle) -> Vec<String> {
+        // A resumed render's settings are its state's (`resume_defaults`), whatever the file says.
+        let resumed = self.session.as_ref().is_some_and(|s| s.resumed_header().is_some());
+        if std::mem::replace(&mut self.resolved, true) || !self.file_defaults || resumed {
+            return vec![];
         }
+        let given = |name: &str| self.given.as_ref().is_some_and(|g| g.iter().any(|n| n == name));
+        let mut notes = Vec::new();
+        if let Some([w, h]) = scene.film_size() {
+            if !given("width") && !given("height") {
+                (self.settings.width, self.settings.height) = (w, h);
+                notes.push(format!("image size {w}x{h} from the scene file (--width/--height override it)"));
+            }
+        }
+        let file = &scene.scene().file_settings;
+        if let Some((depth, source)) = &file.max_depth {
+            let path = !given("mode") || self.settings.mode == Mode::Path;
+            if path && !given("max_depth") {
+                self.settings.mode = Mode::Path;
+                self.settings.max_depth = *depth;
+                notes.push(format!(
+                    "--mode path --max-depth {depth} from the scene file ({source}; --mode/--max-depth override it)"
+                ));
+            }
+        }
+        if let Some((spp, source)) = &file.spp {
+            if !given("spp") && !given("time") && self.session.is_none() {
+                let used = crate::render::samplers::check_spp(self.settings.sampler, *spp).unwrap_or(*spp);
+                self.budget = Budget::Samples(used);
+                notes.push(format!("--spp {used} from the scene file ({source}; --spp/--time override it)"));
+            }
+        }
+        notes
     }
 
     /// The state file this job writes, if it writes one.
@@ -116,4 +163,14 @@ fn resume_defaults(flags: &RenderFlags, path: &Path, saved: &StateHeader) -> Res
         .map_err(|e| ApiError::State(format!("{}: the state's settings cannot be read: {e}", path.display())))?;
     settings.validate().map_err(|e| ApiError::State(format!("{}: {e}", path.display())))?;
     Ok(RenderFlags { spp: Some(flags.spp.unwrap_or(saved.spp_total)), settings, ..flags.clone() })
+}
+
+/// The settings whose value differs from the default (taken as given where the front end does not say).
+fn non_default_settings(settings: &Settings) -> Vec<String> {
+    let map = |s: &Settings| match serde_json::to_value(s) {
+        Ok(serde_json::Value::Object(m)) => m,
+        _ => Default::default(),
+    };
+    let default = map(&Settings::default());
+    map(settings).into_iter().filter(|(k, v)| default.get(k) != Some(v)).map(|(k, _)| k).collect()
 }

@@ -77,10 +77,10 @@ impl Render {
         observer: &mut dyn Observer,
     ) -> Result<Render, ApiError> {
         let t0 = Instant::now();
-        let (settings, size_note) = job.settings_for(scene);
-        if let Some(note) = size_note {
+        for note in job.resolve(scene) {
             observer.note(&format!("note: {note}"));
         }
+        let settings = job.settings.clone();
         if let Some(w) = reachability::unreachable_light_warning(scene.data(), &settings) {
             observer.note(&format!("warning: {w}"));
         }

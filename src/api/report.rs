@@ -40,6 +40,20 @@ impl SceneHandle {
                 Environment::Map { map, .. } => format!("map {} ({}x{})", map.path.display(), map.width, map.height),
             }
         ));
+        let file = &scene.file_settings;
+        let mut stated = Vec::new();
+        if let Some([w, h]) = scene.film_size {
+            stated.push(format!("image {w}x{h}"));
+        }
+        if let Some((depth, source)) = &file.max_depth {
+            stated.push(format!("--mode path --max-depth {depth} ({source})"));
+        }
+        if let Some((spp, source)) = &file.spp {
+            stated.push(format!("--spp {spp} ({source})"));
+        }
+        if !stated.is_empty() {
+            lines.push(format!("render settings from the file (flags override them): {}", stated.join(", ")));
+        }
         let lamps = data.convex_lamps();
         if lamps > 0 {
             lines.push(format!(

@@ -449,11 +449,24 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// The image size the file asks for (pbrt `Film`, Mitsuba `hdrfilm`), used when none is given.
     pub film_size: Option<[u32; 2]>,
+    /// The render settings the file states (pbrt `Integrator` and `Sampler`, Mitsuba `<integrator>` and
+    /// `<sampler>`): the defaults of a render of it, which flags override.
+    pub file_settings: FileSettings,
     /// pbrt / Mitsuba imports: what was imported and what was ignored, one line each (`mislab info`).
     pub import_report: Vec<String>,
     /// Keep every emissive triangle a light of its own even where its mesh could be a convex lamp
     /// (`accel::convex_lamps`): `veach-mis-triangles`, which is there to show light selection among 80,640 lights.
     pub emitter_triangles_kept: bool,
+}
+
+/// Render settings a scene file states, each with where it was stated (`scene.pbrt: line 3`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FileSettings {
+    /// Path tracing with at most this many bounces (pbrt's `maxdepth`; Mitsuba's `max_depth` − 1); 1 is direct
+    /// lighting only.
+    pub max_depth: Option<(u32, String)>,
+    /// Samples per pixel (pbrt's `pixelsamples`, Mitsuba's `sample_count`).
+    pub spp: Option<(u32, String)>,
 }
 
 impl Scene {

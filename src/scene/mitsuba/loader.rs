@@ -138,6 +138,29 @@ impl Loader {
             "shape" => self.shape(file, e)?,
             "emitter" => self.emitter(file, e, None)?,
             "sensor" => self.sensor(file, e)?,
+            "integrator"
+                if matches!(
+                    self.attr(file, e, "type")?.as_deref(),
+                    Some("path" | "volpath" | "volpathmis" | "prb" | "ptracer")
+                ) =>
+            {
+                // Mitsuba counts path vertices (2 is direct lighting; -1, its default, is unbounded); mislab bounces.
+                let depth = self.int_prop(file, e, "max_depth", -1)?;
+                let bounces = match depth {
+                    -1 => 256,
+                    d if (2..=257).contains(&d) => (d - 1) as u32,
+                    d => return Err(self.err(file, e, format!("max_depth {d} is out of range (-1 or 2..=257)"))),
+                };
+                let t = self.attr(file, e, "type")?.unwrap_or_default();
+                if t != "path" {
+                    self.b.warnings.push(format!(
+                        "<integrator type=\"{t}\"> ({}) is rendered as path tracing with the same depth",
+                        at(file, e.line)
+                    ));
+                }
+                let source = format!("<integrator type=\"{t}\"> at {}", at(file, e.line));
+                self.b.scene.file_settings.max_depth = Some((bounces, source));
+            }
             "integrator" | "sampler" | "film" | "rfilter" | "medium" | "phase" => {
                 let t = clip(e.attr("type").unwrap_or(""), 40);
                 self.b.ignore_at(format!("<{} type=\"{t}\">", e.tag), at(file, e.line));
@@ -146,6 +169,15 @@ impl Loader {
             other => return Err(self.err(file, e, format!("unknown element <{other}> in <scene>"))),
         }
         Ok(())
+    }
+
+    /// The `<integer name=NAME value=...>` child of `e`, or `default`.
+    fn int_prop(&self, file: &Path, e: &Element, name: &str, default: i64) -> Result<i64, SceneError> {
+        let Some(c) = e.children.iter().find(|c| c.tag == "integer" && c.attr("name") == Some(name)) else {
+            return Ok(default);
+        };
+        let v = self.need(file, c, "value")?;
+        v.trim().parse::<i64>().map_err(|_| self.err(file, c, format!("{name} '{}' is not an integer", clip(&v, 40))))
     }
 
     /// Numbers separated by spaces or commas; each must be a finite 32-bit float (Mitsuba's `Float`): 1e39 would
@@ -581,6 +613,16 @@ impl Loader {
                 }
             }
         }
+        if let Some(s) = e.children.iter().find(|c| c.tag == "sampler") {
+            // Mitsuba 3's default sample_count is 4.
+            let n = self.int_prop(file, s, "sample_count", 4)?;
+            if !(1..=1 << 24).contains(&n) {
+                return Err(self.err(file, s, format!("sample_count {n} is out of range")));
+            }
+            let kind = self.attr(file, s, "type")?.unwrap_or_default();
+            let source = format!("<sampler type=\"{kind}\"> at {}", at(file, s.line));
+            self.b.scene.file_settings.spp = Some((n as u32, source));
+        }
         let aspect = w as f64 / h as f64;
         let half = (fov.to_radians() / 2.0).tan();
         let vhalf = match axis.as_str() {
@@ -610,7 +652,9 @@ impl Loader {
         self.b.scene.film_size = Some([w, h]);
         self.b.count("camera (perspective)", 1);
         for c in &e.children {
-            if !matches!(c.tag.as_str(), "transform" | "film") && !matches!(c.attr("name"), Some("fov" | "fov_axis")) {
+            if !matches!(c.tag.as_str(), "transform" | "film" | "sampler")
+                && !matches!(c.attr("name"), Some("fov" | "fov_axis"))
+            {
                 self.b.ignore(format!("<sensor> property <{} name=\"{}\">", c.tag, c.attr("name").unwrap_or("")));
             }
         }

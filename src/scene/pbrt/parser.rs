@@ -118,6 +118,11 @@ pub struct Parser {
     mirror: DMat4,
 }
 
+/// pbrt-v4 integrators that estimate the same light transport as path tracing: mislab renders them as path
+/// tracing with their `maxdepth` (others, such as "ambientocclusion", are ignored with a warning).
+const INTEGRATORS_AS_PATHS: &[&str] =
+    &["path", "volpath", "bdpt", "mlt", "sppm", "simplepath", "simplevolpath", "randomwalk", "lightpath"];
+
 impl Parser {
     /// A parser for the file at `main` (relative paths in it resolve against its directory, as in pbrt, and may
     /// leave it only with `options.allow_outside_paths`).
@@ -489,7 +494,36 @@ impl Parser {
                 }
                 return Ok(());
             }
-            "Integrator" | "Sampler" | "PixelFilter" | "Accelerator" | "ColorSpace" | "Option" | "MakeNamedMedium"
+            "Integrator" if INTEGRATORS_AS_PATHS.contains(&kind) => {
+                // pbrt-v4's default maxdepth is 5 for every integrator that has one.
+                let depth = p.int("maxdepth", 5)?;
+                if !(1..=256).contains(&depth) {
+                    return Err(p.error(format!("Integrator \"{kind}\": maxdepth {depth} is out of range (1..=256)")));
+                }
+                let at = at(&p.file, p.line);
+                if !matches!(kind, "path" | "volpath") {
+                    self.b.warnings.push(format!(
+                        "Integrator \"{kind}\" (at {at}) is rendered as path tracing with the same maxdepth, the nearest \
+                         estimator mislab has"
+                    ));
+                }
+                self.b.scene.file_settings.max_depth = Some((depth as u32, format!("Integrator \"{kind}\" at {at}")));
+            }
+            "Sampler" => {
+                let spp = match kind {
+                    "stratified" => p.int("xsamples", 4)? * p.int("ysamples", 4)?,
+                    _ => p.int("pixelsamples", 16)?,
+                };
+                if !(1..=1 << 24).contains(&spp) {
+                    return Err(p.error(format!("Sampler \"{kind}\": {spp} samples per pixel is out of range")));
+                }
+                p.has("jitter");
+                p.has("seed");
+                p.has("randomization");
+                let at = at(&p.file, p.line);
+                self.b.scene.file_settings.spp = Some((spp as u32, format!("Sampler \"{kind}\" at {at}")));
+            }
+            "Integrator" | "PixelFilter" | "Accelerator" | "ColorSpace" | "Option" | "MakeNamedMedium"
             | "MediumInterface" | "Attribute" | "CoordinateSystem" | "CoordSysTransform" | "TransformTimes"
             | "ActiveTransform" => {
                 let what = if kind.is_empty() { d.to_string() } else { format!("{d} \"{kind}\"") };
