@@ -34,7 +34,7 @@ fn write_mask() -> PathBuf {
 /// (half-side 1, radiance 1) at y = 1 facing down, a Lambert 0.5 floor at y = 0; the camera at y = 0.25 looks up
 /// (at the light through the mask, 60°) or down (at the floor, 1°).
 fn load(camera_up: bool, masked: bool) -> Scene {
-    let mask = write_mask();
+    write_mask(); // beside the scene file, named relative to it (scene files may not reach outside their folder)
     let look = if camera_up {
         "LookAt 0 0.25 0  0 1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 60 ]"
     } else {
@@ -45,7 +45,7 @@ fn load(camera_up: bool, masked: bool) -> Scene {
         r#"{look}
 Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
 WorldBegin
-Texture "mask" "float" "imagemap" "string filename" [ "{}" ] "string encoding" "linear"
+Texture "mask" "float" "imagemap" "string filename" [ "checker.png" ] "string encoding" "linear"
 AttributeBegin
   Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
   Shape "trianglemesh" "point3 P" [ -10 0 -10  10 0 -10  10 0 10  -10 0 10 ] "integer indices" [ 0 2 1 0 3 2 ]
@@ -60,8 +60,7 @@ AttributeBegin
   Material "diffuse" "rgb reflectance" [ 0 0 0 ]
   Shape "trianglemesh" "point3 P" [ -1 1 -1  1 1 -1  1 1 1  -1 1 1 ] "integer indices" [ 0 1 2 0 2 3 ]
 AttributeEnd
-"#,
-        mask.display()
+"#
     );
     let path = dir().join(format!("alpha-{camera_up}-{masked}.pbrt"));
     std::fs::write(&path, text).unwrap();

@@ -112,12 +112,21 @@ impl Job {
         }
         let file = &scene.scene().file_settings;
         if let Some((depth, source)) = &file.max_depth {
-            let path = !given("mode") || self.settings.mode == Mode::Path;
-            if path && !given("max_depth") {
+            // The file's integrator fills the mode and the depth each where not given (--max-depth 17 alone
+            // still path traces, as the file asks; --mode direct alone ignores the file's depth).
+            let mut taken = Vec::new();
+            if !given("mode") {
                 self.settings.mode = Mode::Path;
+                taken.push("--mode path".to_string());
+            }
+            if self.settings.mode == Mode::Path && !given("max_depth") {
                 self.settings.max_depth = *depth;
+                taken.push(format!("--max-depth {depth}"));
+            }
+            if !taken.is_empty() {
                 notes.push(format!(
-                    "--mode path --max-depth {depth} from the scene file ({source}; --mode/--max-depth override it)"
+                    "{} from the scene file ({source}; --mode/--max-depth override it)",
+                    taken.join(" ")
                 ));
             }
         }
