@@ -182,3 +182,34 @@ fn only_32_byte_read_bindings_are_padded() {
     assert_eq!(&p[..48], &[1u8; 48]);
     assert!(p[48..].iter().all(|&b| b == 0));
 }
+
+/// A damaged pipeline cache file is reported and ignored (the run goes on with an empty cache) and the next save
+/// rewrites it whole; a device without a pipeline cache has no store at all.
+#[test]
+fn a_damaged_pipeline_cache_is_a_note_and_is_rewritten_whole() {
+    use mislab::gpu::pipeline_store::{file_for, unframe, PipelineStore};
+    let ctx = common_gpu();
+    let dir = std::env::temp_dir().join(format!("mislab-pcache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let has_cache = ctx.device.features().contains(wgpu::Features::PIPELINE_CACHE);
+    let Some(path) = file_for(&dir, &ctx.info).filter(|_| has_cache) else {
+        assert!(ctx.pipelines.store().is_none(), "a device without a pipeline cache has no store");
+        return;
+    };
+    std::fs::write(&path, b"MISLPC01 this is not what was written").unwrap();
+    let (store, note) = PipelineStore::open(&ctx.device, &ctx.info, &dir);
+    let note = note.expect("a damaged file is reported");
+    assert!(note.contains("ignored") && note.contains(&path.display().to_string()), "{note}");
+    let store = store.expect("the run goes on with an empty cache");
+    drop(store); // saves what the driver holds
+    let written = std::fs::read(&path).unwrap();
+    assert!(unframe(&written).is_ok(), "the file was rewritten in a whole frame");
+    let (again, note) = PipelineStore::open(&ctx.device, &ctx.info, &dir);
+    assert!(again.is_some() && note.is_none(), "the rewritten file loads cleanly: {note:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn common_gpu() -> mislab::gpu::GpuContext {
+    mislab::gpu::GpuContext::new().unwrap_or_else(|e| panic!("this test needs a Vulkan adapter and found none ({e})"))
+}

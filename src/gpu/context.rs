@@ -1,6 +1,7 @@
 //! The GPU context: one Vulkan adapter + device, chosen by `WGPU_ADAPTER_NAME` or by preference,
 //! with the limits the renderer needs and helpers that never wait on the device without a timeout.
 
+use super::pipeline_store::{self, PipelineStore};
 use std::time::Duration;
 
 /// How long any single wait on the device may take before we give up (lavapipe has no watchdog).
@@ -100,29 +101,38 @@ pub struct GpuContext {
 /// Compute pipelines built on one device, by a fingerprint their builder computes from everything that makes
 /// them differ (source, entry point, constants, layout). lavapipe compiles a render pipeline for seconds, so two
 /// renderers of equal pipelines on one device (a bench's configurations, a test binary's renders, the stress
-/// suite's cases) build it once.
+/// suite's cases) build it once. Across processes the driver's own cache, kept on disk, does the same
+/// (`PipelineStore`, where the device offers one).
 #[derive(Clone, Default)]
-pub struct PipelineMemo(std::sync::Arc<std::sync::Mutex<std::collections::HashMap<u64, wgpu::ComputePipeline>>>);
+pub struct PipelineMemo {
+    built: std::sync::Arc<std::sync::Mutex<std::collections::HashMap<u64, wgpu::ComputePipeline>>>,
+    store: Option<std::sync::Arc<PipelineStore>>,
+}
 
 impl PipelineMemo {
     /// The pipeline with `fingerprint`, if one was built on this device.
     pub fn get(&self, fingerprint: u64) -> Option<wgpu::ComputePipeline> {
-        self.0.lock().unwrap_or_else(|e| e.into_inner()).get(&fingerprint).cloned()
+        self.built.lock().unwrap_or_else(|e| e.into_inner()).get(&fingerprint).cloned()
     }
 
     /// Remembers `pipeline` under `fingerprint`.
     pub fn insert(&self, fingerprint: u64, pipeline: &wgpu::ComputePipeline) {
-        self.0.lock().unwrap_or_else(|e| e.into_inner()).insert(fingerprint, pipeline.clone());
+        self.built.lock().unwrap_or_else(|e| e.into_inner()).insert(fingerprint, pipeline.clone());
     }
 
     /// How many pipelines are remembered.
     pub fn len(&self) -> usize {
-        self.0.lock().unwrap_or_else(|e| e.into_inner()).len()
+        self.built.lock().unwrap_or_else(|e| e.into_inner()).len()
     }
 
     /// Whether none is.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The driver's pipeline cache kept on disk, where the device has one: every pipeline is built through it.
+    pub fn store(&self) -> Option<&PipelineStore> {
+        self.store.as_deref()
     }
 }
 
@@ -224,7 +234,18 @@ impl GpuContext {
         }))
         .map_err(|source| GpuError::RequestDevice { adapter: info.name.clone(), source })?;
         let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, pipelines: PipelineMemo::default() })
+        let store = match (features.contains(wgpu::Features::PIPELINE_CACHE), pipeline_store::cache_dir()) {
+            (true, Some(dir)) => {
+                let (store, note) = PipelineStore::open(&device, &info, &dir);
+                if let Some(note) = note {
+                    eprintln!("warning: pipeline cache {note}");
+                }
+                store.map(std::sync::Arc::new)
+            }
+            _ => None,
+        };
+        let pipelines = PipelineMemo { store, ..Default::default() };
+        Ok(GpuContext { instance, adapter, device, queue, info, timestamps, pipelines })
     }
 
     /// The features and limits we ask for: everything the adapter offers that we use.
@@ -232,8 +253,10 @@ impl GpuContext {
         let available = adapter.features();
         // SUBGROUP: the traversal's speculative vote (shaders/bvh.wgsl bvh_all_lanes, src/render/shaders.rs for_device).
         // SHADER_INT64: 32-byte loads of vertices and nodes (shaders/geometry_loads_int64.wgsl, same place).
+        // PIPELINE_CACHE: compiled pipelines kept across processes (`PipelineStore`).
         let features = available
             & (wgpu::Features::TIMESTAMP_QUERY
+                | wgpu::Features::PIPELINE_CACHE
                 | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
                 | wgpu::Features::SUBGROUP
                 | wgpu::Features::SHADER_INT64);

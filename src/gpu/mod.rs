@@ -3,7 +3,9 @@
 
 pub mod context;
 pub mod octahedral;
+pub mod pipeline_store;
 pub mod timer;
 pub mod types;
 
 pub use context::*;
+pub use pipeline_store::PipelineStore;

@@ -36,13 +36,13 @@ impl PipelineCache {
     }
 
     /// Makes sure the pipeline for `key` is here: from this cache, else from the device's memo (another renderer
-    /// built it: same `source` and key), else built by `build` and remembered in both. Every render pipeline has the
+    /// built it: same `source` and key), else built by `build` (through the device's on-disk store, if any) and remembered in both. Every render pipeline has the
     /// same layout, so the source and the key tell them apart.
     pub fn get_or_share<E>(
         &mut self,
         key: PipelineKey,
         source: &str,
-        build: impl FnOnce() -> Result<wgpu::ComputePipeline, E>,
+        build: impl FnOnce(Option<&crate::gpu::PipelineStore>) -> Result<wgpu::ComputePipeline, E>,
     ) -> Result<(), E> {
         if self.map.contains_key(&key) {
             return Ok(());
@@ -53,7 +53,7 @@ impl PipelineCache {
         let pipeline = match self.device.get(fingerprint) {
             Some(p) => p,
             None => {
-                let p = build()?;
+                let p = build(self.device.store())?;
                 self.device.insert(fingerprint, &p);
                 p
             }

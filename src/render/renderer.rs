@@ -314,8 +314,16 @@ impl Renderer {
         let (device, layout) = (&self.device, &self.pipeline_layout);
         let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
         self.pipelines
-            .get_or_share(key, source, || {
-                shaders::compute_pipeline(device, "render", source, "render_main", &key.constants(), Some(layout))
+            .get_or_share(key, source, |store| {
+                shaders::compute_pipeline(
+                    device,
+                    store,
+                    "render",
+                    source,
+                    "render_main",
+                    &key.constants(),
+                    Some(layout),
+                )
             })
             .map_err(RenderError::Pipeline)
     }

@@ -1,6 +1,8 @@
 //! WGSL composition: every shader file is embedded in the binary (the product never reads `shaders/` at
 //! run time); an entry point is an ordered list of files concatenated into one module.
 
+use crate::gpu::PipelineStore;
+
 /// Every WGSL file, by name, embedded at compile time.
 pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
@@ -132,9 +134,11 @@ pub fn with_32_byte_loads(source: &str) -> Option<String> {
     changed.then_some(out)
 }
 
-/// Builds a compute pipeline from a composed module (validated by naga first so errors are readable).
+/// Builds a compute pipeline from a composed module (validated by naga first so errors are readable), through the
+/// driver's on-disk pipeline cache where there is one (`store`; saved as soon as the pipeline is built).
 pub fn compute_pipeline(
     device: &wgpu::Device,
+    store: Option<&PipelineStore>,
     label: &str,
     source: &str,
     entry: &str,
@@ -147,12 +151,18 @@ pub fn compute_pipeline(
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source),
     });
-    Ok(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout,
         module: &module,
         entry_point: Some(entry),
         compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: false },
-        cache: None,
-    }))
+        cache: store.map(PipelineStore::cache),
+    });
+    if let Some(store) = store {
+        if let Err(e) = store.save() {
+            eprintln!("warning: pipeline cache {}: not saved ({e})", store.path().display());
+        }
+    }
+    Ok(pipeline)
 }

@@ -89,8 +89,9 @@ impl ScenePipelines {
         });
         let mut entries = Vec::new();
         for entry in entry_points {
-            let pipeline = crate::render::shaders::compute_pipeline(device, entry, source, entry, &[], Some(&layout))
-                .map_err(ProbeError::Shader)?;
+            let pipeline =
+                crate::render::shaders::compute_pipeline(device, None, entry, source, entry, &[], Some(&layout))
+                    .map_err(ProbeError::Shader)?;
             entries.push((entry.to_string(), pipeline));
         }
         let params = device.create_buffer(&wgpu::BufferDescriptor {

@@ -238,6 +238,7 @@ impl DisplayPass {
             .map(|v| {
                 crate::render::shaders::compute_pipeline(
                     &device,
+                    None,
                     "display",
                     &display_source(),
                     "display_main",
@@ -248,6 +249,7 @@ impl DisplayPass {
             .collect::<Result<Vec<_>, _>>()?;
         let stats_pipeline = crate::render::shaders::compute_pipeline(
             &device,
+            None,
             "display stats",
             &display_source(),
             "stats_main",

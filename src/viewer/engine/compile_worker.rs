@@ -4,7 +4,7 @@
 
 use super::side::SideState;
 use super::{Engine, PipelineState};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, PipelineMemo};
 use crate::render::features::PipelineKey;
 use crate::render::settings::{Settings, Strategy};
 use crate::render::Renderer;
@@ -48,6 +48,7 @@ const WARM_UP_TIMEOUT: Duration = Duration::from_secs(900);
 /// stalling its queue for the whole compile.
 fn compile_worker(
     device: wgpu::Device,
+    memo: PipelineMemo,
     layout: wgpu::PipelineLayout,
     warm: Option<GpuContext>,
     jobs: Receiver<CompileJob>,
@@ -102,6 +103,7 @@ fn compile_worker(
         let constants = job.key.constants();
         let result = crate::render::shaders::compute_pipeline(
             &device,
+            memo.store(),
             "render",
             &job.source,
             "render_main",
@@ -127,12 +129,12 @@ impl Engine {
         let stop = Arc::new(AtomicBool::new(false));
         let warm =
             if warm_device { GpuContext::from_adapter(ctx.instance.clone(), ctx.adapter.clone()).ok() } else { None };
-        let device = ctx.device.clone();
+        let (device, memo) = (ctx.device.clone(), ctx.pipelines.clone());
         let layout = layout_of.pipeline_layout().clone();
         let stop2 = stop.clone();
         std::thread::Builder::new()
             .name("mislab-compile".into())
-            .spawn(move || compile_worker(device, layout, warm, jobs_rx, done_tx, stop2, wanted))
+            .spawn(move || compile_worker(device, memo, layout, warm, jobs_rx, done_tx, stop2, wanted))
             .expect("spawning the pipeline compiler thread");
         (jobs_tx, done_rx, stop)
     }
