@@ -286,7 +286,13 @@ struct FrameParams {
     lamps_only: u32,       // 1: they are the scene's only emitters
     occluder_first: u32,   // the triangles outside the BVH (src/render/scene_data.rs occluder_split)
     occluder_count: u32,
-    _pad_occluders: vec2<u32>,
+    /// The pixel filter (FILTER_*), its radius and gaussian σ in pixels, and 1 / ∫ of its gaussian over [−r, r]
+    /// (shaders/pixel_filter.wgsl).
+    pixel_filter: u32,
+    filter_radius: f32,
+    filter_sigma: f32,
+    filter_norm: f32,
+    _pad_filter: vec2<u32>,
 }
 
 /// The result of a closest-hit query. `prim` is a primitive reference or INVALID for a miss;

@@ -10,7 +10,7 @@ const WORKGROUP: u32 = 8u;
 /// Hard bound on path length whatever the settings say (lavapipe has no watchdog).
 const MAX_PATH_VERTICES: u32 = 256u;
 
-/// A camera ray through the pixel with a box-filter jitter.
+/// A camera ray through the point `jitter` (pixel units from the pixel's corner) of pixel px.
 fn camera_direction(px: vec2<u32>, jitter: vec2<f32>) -> vec3<f32> {
     let film = (vec2<f32>(px) + jitter) / vec2<f32>(f32(params.width), f32(params.height));
     let x = (2.0 * film.x - 1.0) * params.tan_half_fov * params.aspect;
@@ -40,7 +40,8 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
     r.id = id;
     r.bounce = 0u;
     r.o = params.cam_origin;
-    r.d = camera_direction(px, sample_2d(id, 0u));
+    let filtered = filter_sample(sample_2d(id, 0u));
+    r.d = camera_direction(px, filtered.jitter);
     r.from_p = params.cam_origin;
     r.from_n = vec3<f32>(0.0);
     r.from_transmits = false;
@@ -48,7 +49,7 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
     r.dir_delta = false;
     r.emission_scale = 1.0;
     r.light = LightMeasure(MEASURE_NONE, 0.0);
-    r.beta = vec3<f32>(1.0);
+    r.beta = vec3<f32>(filtered.weight);
     r.l = vec3<f32>(0.0);
     return r;
 }

@@ -20,4 +20,5 @@ fn cfg_env_sampling() -> u32 { return select(params.env_sampling, SPEC_ENV_SAMPL
 fn cfg_light_select() -> u32 { return select(params.light_select, SPEC_LIGHT_SELECT, SPEC_LIGHT_SELECT != INVALID); }
 fn cfg_heuristic() -> u32 { return select(params.heuristic, SPEC_HEURISTIC, SPEC_HEURISTIC != INVALID); }
 fn cfg_mis_kind() -> u32 { return select(params.mis_kind, SPEC_MIS_KIND, SPEC_MIS_KIND != INVALID); }
+fn cfg_filter() -> u32 { return params.pixel_filter; }
 fn cfg_sampler() -> u32 { return select(params.sampler, SPEC_SAMPLER, SPEC_SAMPLER != INVALID); }

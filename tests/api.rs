@@ -100,7 +100,7 @@ fn bitterli(rel: &str) -> String {
 
 #[test]
 fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
-    use mislab::render::settings::Mode;
+    use mislab::render::settings::{Mode, PixelFilter};
     // pbrt-v4: `Integrator "volpath" "integer maxdepth" [65]`, `Sampler "sobol" "integer pixelsamples" [1]`, Film.
     let stairs = SceneHandle::named(&bitterli("staircase2/pbrt-v4/scene-v4.pbrt")).unwrap();
     let f = &stairs.scene().file_settings;
@@ -111,13 +111,26 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     let notes = j.resolve(&stairs);
     assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 65, Budget::Samples(1)));
     assert_eq!([j.settings.width, j.settings.height], stairs.film_size().unwrap());
-    assert_eq!(notes.len(), 3, "{notes:?}");
+    assert_eq!(notes.len(), 4, "{notes:?}");
+    // `PixelFilter "triangle" "float xradius" [1] "float yradius" [1]`.
+    assert_eq!((j.settings.filter, j.settings.filter_radius()), (PixelFilter::Triangle, 1.0));
+    assert!(
+        notes.iter().any(|n| n.contains("--filter triangle --filter-radius 1 ") && n.contains("line 6")),
+        "{notes:?}"
+    );
     assert!(notes.iter().any(|n| n.contains("--max-depth 65") && n.contains("Integrator \"volpath\"")), "{notes:?}");
     // Flags given win, each on its own.
     let mut j = Job::from_pairs(&[("max_depth", "17"), ("spp", "8"), ("width", "64")]).unwrap();
     j.resolve(&stairs);
     assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 17, Budget::Samples(8)));
     assert_eq!(j.settings.width, 64);
+    let mut j = Job::from_pairs(&[("filter", "gaussian")]).unwrap();
+    j.resolve(&stairs);
+    assert_eq!(
+        (j.settings.filter, j.settings.filter_radius()),
+        (PixelFilter::Gaussian, 1.5),
+        "a filter given, its defaults"
+    );
     let mut j = Job::from_pairs(&[("mode", "direct")]).unwrap();
     j.resolve(&stairs);
     assert_eq!(j.settings.mode, Mode::Direct);
@@ -127,6 +140,8 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
     j.resolve(&cornell);
     assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 64, Budget::Samples(64)));
+    // Its film's `<rfilter type="tent"/>`: Mitsuba's tent, radius 1 by default.
+    assert_eq!((j.settings.filter, j.settings.filter_radius()), (PixelFilter::Triangle, 1.0));
     // A built-in scene states nothing: the flags' defaults stand.
     let veach = SceneHandle::named("veach-mis").unwrap();
     let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();

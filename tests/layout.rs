@@ -149,7 +149,11 @@ fn shared_structs_match() {
             lamps_only,
             occluder_first,
             occluder_count,
-            _pad_occluders
+            pixel_filter,
+            filter_radius,
+            filter_sigma,
+            filter_norm,
+            _pad_filter
         ]
     );
     check!(m, "Hit", GpuHit, [t, prim, b1, b2]);
@@ -194,6 +198,7 @@ fn tag_constants_match() {
     check_enum!(m, Heuristic);
     check_enum!(m, MisKind);
     check_enum!(m, SamplerKind);
+    check_enum!(m, PixelFilter);
     for (name, v) in [
         ("PRIM_TRIANGLE", PRIM_TRIANGLE),
         ("PRIM_SPHERE", PRIM_SPHERE),

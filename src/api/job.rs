@@ -5,7 +5,7 @@ use super::budget::Budget;
 use super::error::ApiError;
 use super::flags::RenderFlags;
 use super::scene::SceneHandle;
-use crate::render::settings::{Mode, Settings};
+use crate::render::settings::{Mode, PixelFilter, Settings};
 use crate::state::session::Session;
 use crate::state::StateHeader;
 use std::path::Path;
@@ -128,6 +128,19 @@ impl Job {
                     "{} from the scene file ({source}; --mode/--max-depth override it)",
                     taken.join(" ")
                 ));
+            }
+        }
+        if let Some((f, source)) = &file.filter {
+            if !given("filter") && !given("filter_radius") && !given("filter_sigma") {
+                if let Ok(shape) = f.shape.parse::<PixelFilter>() {
+                    self.settings.filter = shape;
+                    self.settings.filter_radius = Some(f.radius);
+                    self.settings.filter_sigma = f.sigma;
+                    notes.push(format!(
+                        "{} from the scene file ({source}; --filter/--filter-radius/--filter-sigma override it)",
+                        super::report::filter_flags(f)
+                    ));
+                }
             }
         }
         if let Some((spp, source)) = &file.spp {

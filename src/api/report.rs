@@ -51,6 +51,9 @@ impl SceneHandle {
         if let Some((spp, source)) = &file.spp {
             stated.push(format!("--spp {spp} ({source})"));
         }
+        if let Some((f, source)) = &file.filter {
+            stated.push(format!("{} ({source})", filter_flags(f)));
+        }
         if !stated.is_empty() {
             lines.push(format!("render settings from the file (flags override them): {}", stated.join(", ")));
         }
@@ -105,4 +108,10 @@ impl SceneHandle {
         lines.push(format!("features (code paths compiled into its specialised pipelines): {}", features.describe()));
         lines
     }
+}
+
+/// The flags that select a file's pixel filter.
+pub fn filter_flags(f: &crate::scene::FileFilter) -> String {
+    let sigma = if f.shape == "gaussian" { format!(" --filter-sigma {}", f.sigma) } else { String::new() };
+    format!("--filter {} --filter-radius {}{sigma}", f.shape, f.radius)
 }

@@ -258,7 +258,13 @@ pub struct GpuFrameParams {
     /// the generic pipeline tests in a loop (a scene's own pipeline has them as literals).
     pub occluder_first: u32,
     pub occluder_count: u32,
-    pub _pad_occluders: [u32; 2],
+    /// The pixel filter (`PixelFilter` tag), its radius and gaussian σ in pixels, and 1 / ∫ of its gaussian over
+    /// [−r, r] (`render::pixel_filter`).
+    pub pixel_filter: u32,
+    pub filter_radius: f32,
+    pub filter_sigma: f32,
+    pub filter_norm: f32,
+    pub _pad_filter: [u32; 2],
 }
 
 /// A closest-hit result (WGSL `Hit`), used by probe kernels.

@@ -13,6 +13,7 @@ pub mod gpu_scene;
 pub mod light_table;
 pub mod lights;
 pub mod pipeline_cache;
+pub mod pixel_filter;
 pub mod reachability;
 pub mod render_module;
 pub mod renderer;

@@ -12,6 +12,7 @@ pub const RENDER_FILES: &[&str] = &[
     "rng.wgsl",
     "samplers.wgsl",
     "warps.wgsl",
+    "pixel_filter.wgsl",
     "bvh.wgsl",
     "bvh_wide.wgsl",
     "geometry_loads.wgsl",

@@ -11,6 +11,7 @@ use crate::render::features::{Features, PipelineKey};
 use crate::render::film::Film;
 use crate::render::gpu_scene::GpuScene;
 use crate::render::pipeline_cache::PipelineCache;
+use crate::render::pixel_filter;
 use crate::render::render_module::{render_source, render_source_for};
 pub use crate::render::settings::RR_DEPTH;
 use crate::render::settings::{Mode, Settings};
@@ -534,7 +535,11 @@ impl Renderer {
             lamps_only: self.lamps.2 as u32,
             occluder_first: self.occluders.0,
             occluder_count: self.occluders.1,
-            _pad_occluders: [0; 2],
+            pixel_filter: s.filter.tag(),
+            filter_radius: s.filter_radius(),
+            filter_sigma: s.filter_sigma,
+            filter_norm: pixel_filter::gaussian_norm(s.filter_radius(), s.filter_sigma),
+            _pad_filter: [0; 2],
         }
     }
 

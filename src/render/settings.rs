@@ -152,6 +152,31 @@ settings_enum!(
     }
 );
 
+settings_enum!(
+    /// The pixel filter, as pbrt-v4 defines it (Mitsuba's `box`, `tent` and `gaussian` are the same shapes):
+    /// a pixel's value is its radiance weighted by the filter centred on it. Samples are drawn from the filter
+    /// (filter importance sampling, as pbrt-v4 does), so no sample is shared between pixels.
+    PixelFilter, "FILTER_" {
+        /// Constant over [−r, r]² (r = 0.5: the pixel itself).
+        Box = 0 => "box",
+        /// (r − |x|)(r − |y|), pbrt-v4's `triangle` and Mitsuba's `tent`.
+        Triangle = 1 => "triangle",
+        /// (G(x) − G(r))(G(y) − G(r)) with G a normal density of deviation `--filter-sigma`.
+        Gaussian = 2 => "gaussian",
+    }
+);
+
+impl PixelFilter {
+    /// The radius pbrt-v4 gives the filter when none is stated (box 0.5, triangle 2, gaussian 1.5).
+    pub fn default_radius(self) -> f32 {
+        match self {
+            PixelFilter::Box => 0.5,
+            PixelFilter::Triangle => 2.0,
+            PixelFilter::Gaussian => 1.5,
+        }
+    }
+}
+
 /// Every setting that changes what is estimated or how. Film size and sample budget live here too so
 /// one struct describes a render (and a benchmark row). Each field is declared once: its doc comment is the
 /// `--flag`'s help, its default is `Settings::default()`'s.
@@ -216,6 +241,15 @@ pub struct Settings {
     /// Seed of every random number (an integer from 0 to 4294967295).
     #[arg(long, default_value_t = Settings::default().seed)]
     pub seed: u32,
+    /// Pixel filter (what a pixel's value is an average of).
+    #[arg(long, value_enum, default_value_t = Settings::default().filter)]
+    pub filter: PixelFilter,
+    /// Radius of the pixel filter in pixels (0.05 to 16; default: box 0.5, triangle 2, gaussian 1.5, as pbrt-v4).
+    #[arg(long)]
+    pub filter_radius: Option<f32>,
+    /// Standard deviation of the gaussian filter in pixels (0.05 to 16).
+    #[arg(long, default_value_t = Settings::default().filter_sigma)]
+    pub filter_sigma: f32,
     /// Exposure in stops (-64 to 64) for PNG output and display (EXR output is linear radiance and ignores it).
     #[arg(long, allow_hyphen_values = true, default_value_t = Settings::default().exposure, value_parser = crate::io::cli_values::exposure)]
     pub exposure: f32,
@@ -243,11 +277,19 @@ impl Default for Settings {
             rr_depth: RR_DEPTH,
             seed: 0,
             exposure: 0.0,
+            filter: PixelFilter::Box,
+            filter_radius: None,
+            filter_sigma: 0.5,
         }
     }
 }
 
 impl Settings {
+    /// The pixel filter's radius: the one given, else the filter's own default.
+    pub fn filter_radius(&self) -> f32 {
+        self.filter_radius.unwrap_or(self.filter.default_radius())
+    }
+
     /// Checks values that the type system does not: sizes, counts, β.
     pub fn validate(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 {
@@ -273,6 +315,13 @@ impl Settings {
         }
         if !(self.exposure.is_finite() && self.exposure.abs() <= crate::io::cli_values::MAX_EXPOSURE) {
             return Err(format!("exposure {} is out of range (-64..=64 stops)", self.exposure));
+        }
+        let radius = self.filter_radius();
+        if !(radius.is_finite() && (0.05..=16.0).contains(&radius)) {
+            return Err(format!("--filter-radius {radius} is out of range (0.05 to 16 pixels)"));
+        }
+        if !(self.filter_sigma.is_finite() && (0.05..=16.0).contains(&self.filter_sigma)) {
+            return Err(format!("--filter-sigma {} is out of range (0.05 to 16 pixels)", self.filter_sigma));
         }
         if self.max_depth == 0 || self.max_depth > 256 {
             return Err(format!("--max-depth {} is out of range (1..=256)", self.max_depth));

@@ -16,6 +16,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("rng.wgsl", include_str!("../../shaders/rng.wgsl")),
     ("samplers.wgsl", include_str!("../../shaders/samplers.wgsl")),
     ("warps.wgsl", include_str!("../../shaders/warps.wgsl")),
+    ("pixel_filter.wgsl", include_str!("../../shaders/pixel_filter.wgsl")),
     ("bsdf_conductor.wgsl", include_str!("../../shaders/bsdf_conductor.wgsl")),
     ("bsdf_coated_diffuse.wgsl", include_str!("../../shaders/bsdf_coated_diffuse.wgsl")),
     ("bsdf_dielectric.wgsl", include_str!("../../shaders/bsdf_dielectric.wgsl")),

@@ -467,6 +467,19 @@ pub struct FileSettings {
     pub max_depth: Option<(u32, String)>,
     /// Samples per pixel (pbrt's `pixelsamples`, Mitsuba's `sample_count`).
     pub spp: Option<(u32, String)>,
+    /// The pixel filter (pbrt's `PixelFilter`, Mitsuba's `<rfilter>`).
+    pub filter: Option<(FileFilter, String)>,
+}
+
+/// A pixel filter as a scene file states it, in pbrt-v4's terms (`render::settings::PixelFilter` names the shapes).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileFilter {
+    /// "box", "triangle" or "gaussian".
+    pub shape: &'static str,
+    /// Radius in pixels.
+    pub radius: f32,
+    /// The gaussian's standard deviation in pixels.
+    pub sigma: f32,
 }
 
 impl Scene {

@@ -8,7 +8,7 @@ use crate::scene::env_import::{self, Layout};
 use crate::scene::import_build::{self, Builder, ObjectMesh};
 use crate::scene::import_material::{MatParam, MaterialDesc, TexDesc};
 use crate::scene::read_input::{at, included_from, read_bytes, SceneDir};
-use crate::scene::{Camera, Environment, LoadOptions, PunctualLight, Scene, SceneError};
+use crate::scene::{Camera, Environment, FileFilter, LoadOptions, PunctualLight, Scene, SceneError};
 use glam::{DMat4, DVec3, Mat3, Vec3};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -578,6 +578,40 @@ impl Loader {
         Ok(())
     }
 
+    /// The film's `<rfilter>`: Mitsuba 3's box (radius 0.5), tent (`radius`, 1) and gaussian (`stddev`, 0.5; radius
+    /// 4σ) are pbrt-v4's shapes; mitchell, catmullrom and lanczos become a gaussian of their radius, with a warning.
+    fn rfilter(&mut self, file: &Path, f: &Element) -> Result<(), SceneError> {
+        let kind = self.attr(file, f, "type")?.unwrap_or_default();
+        let sigma = self.float_prop(file, f, "stddev", 0.5)?;
+        let (shape, radius) = match kind.as_str() {
+            "box" => ("box", 0.5),
+            "tent" => ("triangle", self.float_prop(file, f, "radius", 1.0)?),
+            "gaussian" => ("gaussian", 4.0 * sigma),
+            "mitchell" | "catmullrom" => ("gaussian", 2.0),
+            "lanczos" => ("gaussian", self.int_prop(file, f, "lobes", 3)? as f32),
+            other => return Err(self.err(file, f, format!("unknown <rfilter type=\"{}\">", clip(other, 40)))),
+        };
+        for (name, v) in [("radius", radius), ("stddev", sigma)] {
+            if !(v.is_finite() && (0.05..=16.0).contains(&v)) {
+                return Err(self.err(
+                    file,
+                    f,
+                    format!("<rfilter type=\"{kind}\">: {name} {v} is out of range (0.05 to 16)"),
+                ));
+            }
+        }
+        let at = at(file, f.line);
+        if !matches!(kind.as_str(), "box" | "tent" | "gaussian") {
+            self.b.warnings.push(format!(
+                "<rfilter type=\"{kind}\"> (at {at}) is rendered with a gaussian filter of radius {radius}, the nearest \
+                 mislab has (it has no negative lobes)"
+            ));
+        }
+        let source = format!("<rfilter type=\"{kind}\"> at {at}");
+        self.b.scene.file_settings.filter = Some((FileFilter { shape, radius, sigma: sigma.min(16.0) }, source));
+        Ok(())
+    }
+
     fn sensor(&mut self, file: &Path, e: &Element) -> Result<(), SceneError> {
         let ty = self.need(file, e, "type")?;
         if ty != "perspective" {
@@ -611,6 +645,9 @@ impl Loader {
                     Some("height") => h = v()?,
                     _ => {}
                 }
+            }
+            if let Some(f) = film.children.iter().find(|c| c.tag == "rfilter") {
+                self.rfilter(file, f)?;
             }
         }
         if let Some(s) = e.children.iter().find(|c| c.tag == "sampler") {

@@ -16,7 +16,7 @@ use crate::scene::env_import::{self, Layout};
 use crate::scene::import_build::{Builder, ObjectMesh};
 use crate::scene::import_material::{MatParam, MaterialDesc};
 use crate::scene::read_input::{at, included_from, read_bytes, SceneDir};
-use crate::scene::{Camera, Environment, LoadOptions, PunctualLight, Scene, SceneError};
+use crate::scene::{Camera, Environment, FileFilter, LoadOptions, PunctualLight, Scene, SceneError};
 use glam::{DMat4, DVec3, Mat3, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -523,9 +523,45 @@ impl Parser {
                 let at = at(&p.file, p.line);
                 self.b.scene.file_settings.spp = Some((spp as u32, format!("Sampler \"{kind}\" at {at}")));
             }
-            "Integrator" | "PixelFilter" | "Accelerator" | "ColorSpace" | "Option" | "MakeNamedMedium"
-            | "MediumInterface" | "Attribute" | "CoordinateSystem" | "CoordSysTransform" | "TransformTimes"
-            | "ActiveTransform" => {
+            "PixelFilter" => {
+                // pbrt-v4's defaults: box 0.5, triangle 2, gaussian 1.5 (σ 0.5), mitchell 2, sinc 4.
+                let (shape, default_radius) = match kind {
+                    "box" => ("box", 0.5),
+                    "triangle" => ("triangle", 2.0),
+                    "gaussian" => ("gaussian", 1.5),
+                    "mitchell" => ("gaussian", 2.0),
+                    "sinc" => ("gaussian", 4.0),
+                    other => return Err(p.error(format!("unknown PixelFilter \"{}\"", clip(other, 40)))),
+                };
+                let (rx, ry) = (p.float("xradius", default_radius)?, p.float("yradius", default_radius)?);
+                let sigma = p.float("sigma", 0.5)?;
+                for (name, v) in [("xradius", rx), ("yradius", ry), ("sigma", sigma)] {
+                    if !(v.is_finite() && (0.05..=16.0).contains(&v)) {
+                        return Err(p.error(format!("PixelFilter \"{kind}\": {name} {v} is out of range (0.05 to 16)")));
+                    }
+                }
+                let at = at(&p.file, p.line);
+                if rx != ry {
+                    self.b.warnings.push(format!(
+                        "PixelFilter \"{kind}\" (at {at}): xradius {rx} and yradius {ry} differ; mislab's filters have \
+                         one radius, {} is used",
+                        rx.max(ry)
+                    ));
+                }
+                if shape != kind {
+                    self.b.warnings.push(format!(
+                        "PixelFilter \"{kind}\" (at {at}) is rendered with a gaussian filter of the same radius, the \
+                         nearest mislab has (it has no negative lobes)"
+                    ));
+                    p.has("B");
+                    p.has("C");
+                    p.has("tau");
+                }
+                let filter = FileFilter { shape, radius: rx.max(ry), sigma };
+                self.b.scene.file_settings.filter = Some((filter, format!("PixelFilter \"{kind}\" at {at}")));
+            }
+            "Integrator" | "Accelerator" | "ColorSpace" | "Option" | "MakeNamedMedium" | "MediumInterface"
+            | "Attribute" | "CoordinateSystem" | "CoordSysTransform" | "TransformTimes" | "ActiveTransform" => {
                 let what = if kind.is_empty() { d.to_string() } else { format!("{d} \"{kind}\"") };
                 self.b.ignore(what);
                 for u in p.unused() {
