@@ -42,7 +42,7 @@ fn malformed_files_name_file_and_line() {
         ("bad-indices.pbrt", "bad-indices.pbrt: line 3", "out of range"),
         ("inline-indices.pbrt", "inline-indices.pbrt: line 2", "out of range"),
         ("circular-a.pbrt", "circular-b.pbrt: line 2", "circular Include"),
-        ("truncated.xml", "truncated.xml: line 2", "never closed"),
+        ("truncated.xml", "truncated.xml: line 3", "never closed"),
         ("unknown-element.xml", "unknown-element.xml: line 3", "unknown element <teapot>"),
         ("wrong-value.xml", "wrong-value.xml: line 3", "not a list of finite numbers"),
         ("missing-obj.xml", "missing-obj.xml: line 2", "missing.obj: file not found"),

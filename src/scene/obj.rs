@@ -1,5 +1,9 @@
 //! Wavefront OBJ meshes (Mitsuba's `obj` shape): `v`, `vt`, `vn` and polygon `f` records (1-based or negative
 //! indices, `v`, `v/vt`, `v//vn`, `v/vt/vn`), fanned into triangles; other records are skipped.
+//!
+//! Our own rather than `tobj`: its `LoadError` is a bare kind (`PositionParseError`, `FaceParseError`, …) with no
+//! line, and an error must name the line; and `tobj::load_obj` opens `mtllib` files itself, outside the scene-folder
+//! containment every other referenced file goes through (Mitsuba ignores OBJ materials anyway).
 
 use super::ply::PlyMesh;
 use glam::{Vec2, Vec3};
