@@ -47,7 +47,7 @@ fn malformed_files_name_file_and_line() {
         ("wrong-value.xml", "wrong-value.xml: line 3", "not a list of finite numbers"),
         ("missing-obj.xml", "missing-obj.xml: line 2", "missing.obj: file not found"),
         ("circular.xml", "circular.xml: line 2", "circular include"),
-        ("missing-ref.xml", "missing-ref.xml: line 3", "no <bsdf id=\"nothing\">"),
+        ("missing-ref.xml", "missing-ref.xml: line 3", "no <bsdf> or area <emitter> with id=\"nothing\""),
     ];
     let mut failures = vec![];
     for (file, at, what) in cases {
@@ -157,6 +157,24 @@ fn mitsuba_emitters_without_a_bsdf_reflect_nothing() {
     assert_eq!((lamp.len(), plain.len()), (1, 1), "{:?}", s.materials.iter().map(|m| &m.name).collect::<Vec<_>>());
     assert_eq!(lamp[0].base_color, glam::Vec3::ZERO, "{}", lamp[0].name);
     assert_eq!(plain[0].base_color, glam::Vec3::splat(0.5), "{}", plain[0].name);
+}
+
+/// Mitsuba 3 resolves `<ref id>` across the whole scene and lets a shape take a named area emitter by reference:
+/// mitsuba-data's `cbox-rgb.xml` includes shapes that refer to an `<emitter type="area" id="area-emitter">` its main
+/// file declares after the include. It loads as `cbox.xml` does (same meshes), with that radiance on the luminaire.
+#[test]
+fn mitsuba_references_reach_forward_and_take_named_area_emitters() {
+    use mislab::scene::{load, LoadOptions};
+    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/scenes/mitsuba-data/cbox"));
+    let rgb =
+        load(dir.join("cbox-rgb.xml").to_str().unwrap(), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let plain = load(dir.join("cbox.xml").to_str().unwrap(), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(rgb.meshes.len(), plain.meshes.len());
+    assert_eq!(rgb.triangle_count(), plain.triangle_count());
+    let lamps: Vec<_> = rgb.materials.iter().filter(|m| m.emission != glam::Vec3::ZERO).collect();
+    assert_eq!(lamps.len(), 1, "{:?}", rgb.materials.iter().map(|m| &m.name).collect::<Vec<_>>());
+    let want = glam::Vec3::new(18.387, 10.9873, 2.75357);
+    assert!((lamps[0].emission - want).abs().max_element() < 1e-4, "{} vs {want}", lamps[0].emission);
 }
 
 /// Mitsuba 3's envmap lat-long (u = atan2(x, −z)/2π, v = acos(y)/π in the emitter's frame, then its to_world) is

@@ -24,6 +24,13 @@ pub struct Loader {
     b: Builder,
     defaults: HashMap<String, String>,
     bsdfs: HashMap<String, usize>,
+    /// Top-level `<emitter type="area" id=…>`s, which shapes take by `<ref id=…>` (Mitsuba 3 resolves references
+    /// across the whole scene, so a shape may come before what it refers to).
+    area_emitters: HashMap<String, (PathBuf, Element)>,
+    /// Shapes whose references name nothing seen yet: read once the whole scene has been, with where they were.
+    deferred: Vec<(PathBuf, String, Element)>,
+    /// Where the file being read was included from ("" for the main file).
+    included_by: String,
     includes: Vec<PathBuf>,
     default_material: usize,
     default_emitter_material: usize,
@@ -54,6 +61,9 @@ impl Loader {
             b,
             defaults: HashMap::new(),
             bsdfs: HashMap::new(),
+            area_emitters: HashMap::new(),
+            deferred: vec![],
+            included_by: String::new(),
             includes: vec![],
             default_material,
             default_emitter_material,
@@ -64,6 +74,9 @@ impl Loader {
     pub fn run(mut self) -> Result<Scene, SceneError> {
         let main = self.main.clone();
         self.file(&main, "")?;
+        for (file, by, e) in std::mem::take(&mut self.deferred) {
+            self.shape(&file, &e).map_err(|err| included_from(&file, &by, err))?;
+        }
         self.b.scene.name = main.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         Ok(self.b.finish("Mitsuba 3"))
     }
@@ -91,7 +104,9 @@ impl Loader {
             )));
         }
         self.includes.push(canonical);
+        let outer = std::mem::replace(&mut self.included_by, by.to_string());
         let r = root.children.iter().try_for_each(|e| self.top(path, e)).map_err(placed);
+        self.included_by = outer;
         self.includes.pop();
         r
     }
@@ -134,6 +149,9 @@ impl Loader {
                 if let Some(id) = e.attr("id") {
                     self.bsdfs.insert(id.to_string(), index);
                 }
+            }
+            "shape" if !self.references_resolve(e) => {
+                self.deferred.push((file.to_path_buf(), self.included_by.clone(), e.clone()))
             }
             "shape" => self.shape(file, e)?,
             "emitter" => self.emitter(file, e, None)?,
@@ -372,6 +390,16 @@ impl Loader {
         Ok(self.b.add_desc(MaterialDesc { name, kind: ty, params, at: at(file, e.line) }))
     }
 
+    /// Whether every `<ref id=…>` of a shape names a BSDF or area emitter already read.
+    fn references_resolve(&self, e: &Element) -> bool {
+        e.children.iter().filter(|c| c.tag == "ref").all(|c| {
+            self.attr(Path::new(""), c, "id")
+                .ok()
+                .flatten()
+                .is_some_and(|id| self.bsdfs.contains_key(&id) || self.area_emitters.contains_key(&id))
+        })
+    }
+
     fn shape(&mut self, file: &Path, e: &Element) -> Result<(), SceneError> {
         let ty = self.need(file, e, "type")?;
         let to_world = self.to_world(file, e)?;
@@ -386,10 +414,15 @@ impl Loader {
                 "bsdf" => material = Some(self.bsdf(file, c)?),
                 "ref" => {
                     let id = self.need(file, c, "id")?;
-                    material =
-                        Some(*self.bsdfs.get(&id).ok_or_else(|| {
-                            self.err(file, c, format!("no <bsdf id=\"{id}\"> before this reference"))
-                        })?);
+                    if let Some(&m) = self.bsdfs.get(&id) {
+                        material = Some(m);
+                    } else if let Some((emitter_file, emitter)) = self.area_emitters.get(&id).cloned() {
+                        emission = self.radiance(&emitter_file, &emitter, "radiance")?;
+                        has_emitter = true;
+                    } else {
+                        let what = format!("no <bsdf> or area <emitter> with id=\"{}\" in the scene", clip(&id, 40));
+                        return Err(self.err(file, c, what));
+                    }
                 }
                 "emitter" => {
                     let t = self.need(file, c, "type")?;
@@ -568,7 +601,15 @@ impl Loader {
                 let direction = d.try_normalize().ok_or_else(|| self.err(file, e, "zero direction"))?.as_vec3();
                 self.b.scene.punctual_lights.push(PunctualLight::Directional { direction, irradiance });
             }
-            "area" => return Err(self.err(file, e, "an area emitter must be inside a <shape>")),
+            "area" => match e.attr("id") {
+                // Named, for shapes to take by reference.
+                Some(id) => {
+                    self.radiance(file, e, "radiance")?;
+                    self.area_emitters.insert(id.to_string(), (file.to_path_buf(), e.clone()));
+                    return Ok(());
+                }
+                None => return Err(self.err(file, e, "an area emitter must be inside a <shape> or have an id")),
+            },
             other => {
                 self.b.ignore_at(format!("<emitter type=\"{}\">", clip(other, 40)), at(file, e.line));
                 return Ok(());
