@@ -100,7 +100,7 @@ fn bitterli(rel: &str) -> String {
 
 #[test]
 fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
-    use mislab::render::settings::{Mode, PixelFilter};
+    use mislab::render::settings::{Mode, PixelFilter, SamplerKind};
     // pbrt-v4: `Integrator "volpath" "integer maxdepth" [65]`, `Sampler "sobol" "integer pixelsamples" [1]`, Film.
     let stairs = SceneHandle::named(&bitterli("staircase2/pbrt-v4/scene-v4.pbrt")).unwrap();
     let f = &stairs.scene().file_settings;
@@ -111,7 +111,9 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     let notes = j.resolve(&stairs);
     assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 65, Budget::Samples(1)));
     assert_eq!([j.settings.width, j.settings.height], stairs.film_size().unwrap());
-    assert_eq!(notes.len(), 4, "{notes:?}");
+    assert_eq!(notes.len(), 5, "{notes:?}");
+    // `Sampler "sobol"`.
+    assert_eq!(j.settings.sampler, SamplerKind::Sobol);
     // `PixelFilter "triangle" "float xradius" [1] "float yradius" [1]`.
     assert_eq!((j.settings.filter, j.settings.filter_radius()), (PixelFilter::Triangle, 1.0));
     assert!(
@@ -124,6 +126,9 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     j.resolve(&stairs);
     assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 17, Budget::Samples(8)));
     assert_eq!(j.settings.width, 64);
+    let mut j = Job::from_pairs(&[("sampler", "independent")]).unwrap();
+    j.resolve(&stairs);
+    assert_eq!(j.settings.sampler, SamplerKind::Independent, "--sampler given wins");
     let mut j = Job::from_pairs(&[("filter", "gaussian")]).unwrap();
     j.resolve(&stairs);
     assert_eq!(
@@ -140,6 +145,7 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
     j.resolve(&cornell);
     assert_eq!((j.settings.mode, j.settings.max_depth, j.budget), (Mode::Path, 64, Budget::Samples(64)));
+    assert_eq!(j.settings.sampler, SamplerKind::Independent, "<sampler type=\"independent\">");
     // Its film's `<rfilter type="tent"/>`: Mitsuba's tent, radius 1 by default.
     assert_eq!((j.settings.filter, j.settings.filter_radius()), (PixelFilter::Triangle, 1.0));
     // A built-in scene states nothing: the flags' defaults stand.
@@ -147,4 +153,20 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
     assert!(j.resolve(&veach).is_empty());
     assert_eq!((j.settings.mode, j.budget), (Mode::Direct, Budget::Samples(api::DEFAULT_SPP)));
+    // A file's sampler is taken only where it can render the sample count: stratified has a maximum (2^20).
+    let dir = std::env::temp_dir().join(format!("mislab-api-sampler-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene_with = |sampler: &str| {
+        let path = dir.join("s.pbrt");
+        let text = format!("{sampler}\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nShape \"sphere\"\n");
+        std::fs::write(&path, text).unwrap();
+        SceneHandle::named(path.to_str().unwrap()).unwrap()
+    };
+    let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
+    j.resolve(&scene_with(r#"Sampler "halton" "integer pixelsamples" [ 8 ]"#));
+    assert_eq!((j.settings.sampler, j.budget), (SamplerKind::Halton, Budget::Samples(8)));
+    let mut j = Job::from_pairs::<&str, &str>(&[]).unwrap();
+    j.resolve(&scene_with(r#"Sampler "stratified" "integer xsamples" [ 2048 ] "integer ysamples" [ 2048 ]"#));
+    assert_eq!((j.settings.sampler, j.budget), (SamplerKind::Independent, Budget::Samples(1 << 22)));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

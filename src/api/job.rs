@@ -5,7 +5,8 @@ use super::budget::Budget;
 use super::error::ApiError;
 use super::flags::RenderFlags;
 use super::scene::SceneHandle;
-use crate::render::settings::{Mode, PixelFilter, Settings};
+use crate::render::samplers::check_spp;
+use crate::render::settings::{Mode, PixelFilter, SamplerKind, Settings};
 use crate::state::session::Session;
 use crate::state::StateHeader;
 use std::path::Path;
@@ -143,9 +144,24 @@ impl Job {
                 }
             }
         }
+        if let Some((name, source)) = &file.sampler {
+            // Taken only where it can render the sample count asked, or else the file's (stratified has a maximum).
+            let spp = match self.budget {
+                Budget::Samples(n) if given("spp") => Some(n),
+                _ => file.spp.as_ref().map(|(n, _)| *n),
+            };
+            let fits = |s: SamplerKind| spp.is_none_or(|n| check_spp(s, n).is_ok());
+            match name.parse::<SamplerKind>() {
+                Ok(s) if !given("sampler") && fits(s) => {
+                    self.settings.sampler = s;
+                    notes.push(format!("--sampler {s} from the scene file ({source}; --sampler overrides it)"));
+                }
+                _ => {}
+            }
+        }
         if let Some((spp, source)) = &file.spp {
             if !given("spp") && !given("time") && self.session.is_none() {
-                let used = crate::render::samplers::check_spp(self.settings.sampler, *spp).unwrap_or(*spp);
+                let used = check_spp(self.settings.sampler, *spp).unwrap_or(*spp);
                 self.budget = Budget::Samples(used);
                 notes.push(format!("--spp {used} from the scene file ({source}; --spp/--time override it)"));
             }

@@ -51,6 +51,9 @@ impl SceneHandle {
         if let Some((spp, source)) = &file.spp {
             stated.push(format!("--spp {spp} ({source})"));
         }
+        if let Some((sampler, source)) = &file.sampler {
+            stated.push(format!("--sampler {sampler} ({source})"));
+        }
         if let Some((f, source)) = &file.filter {
             stated.push(format!("{} ({source})", filter_flags(f)));
         }

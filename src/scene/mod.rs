@@ -467,6 +467,8 @@ pub struct FileSettings {
     pub max_depth: Option<(u32, String)>,
     /// Samples per pixel (pbrt's `pixelsamples`, Mitsuba's `sample_count`).
     pub spp: Option<(u32, String)>,
+    /// The sample sequence, by mislab's name for the nearest it has (pbrt's `Sampler`, Mitsuba's `<sampler>`).
+    pub sampler: Option<(&'static str, String)>,
     /// The pixel filter (pbrt's `PixelFilter`, Mitsuba's `<rfilter>`).
     pub filter: Option<(FileFilter, String)>,
 }

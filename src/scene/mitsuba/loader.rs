@@ -699,6 +699,14 @@ impl Loader {
             }
             let kind = self.attr(file, s, "type")?.unwrap_or_default();
             let source = format!("<sampler type=\"{kind}\"> at {}", at(file, s.line));
+            // Mitsuba 3's samplers, each as the nearest mislab has (its ldsampler is a (0,2)-sequence, as Sobol).
+            let sampler = match kind.as_str() {
+                "independent" => Some("independent"),
+                "stratified" | "multijitter" | "orthogonal" => Some("stratified"),
+                "ldsampler" => Some("sobol"),
+                _ => None,
+            };
+            self.b.scene.file_settings.sampler = sampler.map(|s| (s, source.clone()));
             self.b.scene.file_settings.spp = Some((n as u32, source));
         }
         let aspect = w as f64 / h as f64;

@@ -521,7 +521,17 @@ impl Parser {
                 p.has("seed");
                 p.has("randomization");
                 let at = at(&p.file, p.line);
-                self.b.scene.file_settings.spp = Some((spp as u32, format!("Sampler \"{kind}\" at {at}")));
+                let source = format!("Sampler \"{kind}\" at {at}");
+                // pbrt-v4's samplers, each as the nearest mislab has ((0,2)-sequences as Sobol).
+                let sampler = match kind {
+                    "independent" => Some("independent"),
+                    "stratified" => Some("stratified"),
+                    "halton" => Some("halton"),
+                    "sobol" | "paddedsobol" | "zsobol" | "pmj02bn" => Some("sobol"),
+                    _ => None,
+                };
+                self.b.scene.file_settings.sampler = sampler.map(|s| (s, source.clone()));
+                self.b.scene.file_settings.spp = Some((spp as u32, source));
             }
             "PixelFilter" => {
                 // pbrt-v4's defaults: box 0.5, triangle 2, gaussian 1.5 (σ 0.5), mitchell 2, sinc 4.
