@@ -287,7 +287,7 @@ mod tests {
 
     #[test]
     fn resolve_inside_refuses_what_leaves_the_base() {
-        let base = Path::new("/tmp/scene");
+        let base = &std::env::temp_dir().join("scene");
         assert_eq!(resolve_inside(base, Path::new("/etc/passwd"), false), Err(Outside::Absolute));
         assert_eq!(resolve_inside(base, Path::new("a/../../x"), false), Err(Outside::ParentDir));
         assert_eq!(resolve_inside(base, Path::new("a/../x"), false), Ok(base.join("a/../x")));
