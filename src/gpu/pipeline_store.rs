@@ -25,6 +25,8 @@ pub struct PipelineStore {
     path: PathBuf,
     /// Bytes last read or written, to skip rewriting what did not change.
     saved_len: Mutex<usize>,
+    /// Whether a failed save was reported (once is enough: a read-only cache directory stays so).
+    warned: std::sync::atomic::AtomicBool,
 }
 
 /// What opening the store found, for the user to read: None when it loaded cleanly or there was nothing to load.
@@ -126,7 +128,8 @@ impl PipelineStore {
             })
         };
         let saved_len = data.map_or(0, <[u8]>::len);
-        (Some(PipelineStore { cache, path, saved_len: Mutex::new(saved_len) }), note)
+        let store = PipelineStore { cache, path, saved_len: Mutex::new(saved_len), warned: Default::default() };
+        (Some(store), note)
     }
 
     /// The driver's cache, to hand to every pipeline built.
@@ -169,13 +172,22 @@ impl PipelineStore {
     }
 }
 
+impl PipelineStore {
+    /// `save`, with a failure printed as a warning the first time only.
+    pub fn save_or_warn(&self) {
+        if let Err(e) = self.save() {
+            if !self.warned.swap(true, std::sync::atomic::Ordering::Relaxed) {
+                eprintln!("warning: pipeline cache {}: not saved ({e})", self.path.display());
+            }
+        }
+    }
+}
+
 impl Drop for PipelineStore {
     /// Saves what was compiled since the last save: drivers that compile a pipeline at its first dispatch (lavapipe)
     /// fill the cache after `create_compute_pipeline` returns.
     fn drop(&mut self) {
-        if let Err(e) = self.save() {
-            eprintln!("warning: pipeline cache {}: not saved ({e})", self.path.display());
-        }
+        self.save_or_warn();
     }
 }
 

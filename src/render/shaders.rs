@@ -161,9 +161,7 @@ pub fn compute_pipeline(
         cache: store.map(PipelineStore::cache),
     });
     if let Some(store) = store {
-        if let Err(e) = store.save() {
-            eprintln!("warning: pipeline cache {}: not saved ({e})", store.path().display());
-        }
+        store.save_or_warn();
     }
     Ok(pipeline)
 }
