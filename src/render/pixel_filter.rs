@@ -43,8 +43,13 @@ pub fn gaussian_integral(radius: f64, sigma: f64) -> f64 {
     sum * h / 3.0
 }
 
-/// 1 / `gaussian_integral` as the shader takes it (0 where the integral vanishes, which validation rules out).
-pub fn gaussian_norm(radius: f32, sigma: f32) -> f32 {
+/// The shader's `filter_norm`: 1 / `gaussian_integral` for the gaussian, which alone weighs its samples (0 for the
+/// others, and where the integral vanishes, which validation rules out). A quadrature: not worth doing per dispatch
+/// for filters that do not use it.
+pub fn shader_norm(filter: PixelFilter, radius: f32, sigma: f32) -> f32 {
+    if filter != PixelFilter::Gaussian {
+        return 0.0;
+    }
     let g = gaussian_integral(radius as f64, sigma as f64);
     if g > 0.0 {
         (1.0 / g) as f32

@@ -14,7 +14,7 @@ use crate::render::pipeline_cache::PipelineCache;
 use crate::render::pixel_filter;
 use crate::render::render_module::{render_source, render_source_for};
 pub use crate::render::settings::RR_DEPTH;
-use crate::render::settings::{Mode, PixelFilter, Settings};
+use crate::render::settings::{Mode, Settings};
 use crate::render::shaders;
 use crate::render::tile_order::tile_row_stride;
 use crate::scene::Camera;
@@ -538,11 +538,7 @@ impl Renderer {
             pixel_filter: s.filter.tag(),
             filter_radius: s.filter_radius(),
             filter_sigma: s.filter_sigma,
-            // Only the gaussian's weights use it (a 4096-panel quadrature: not for every dispatch of other filters).
-            filter_norm: match s.filter {
-                PixelFilter::Gaussian => pixel_filter::gaussian_norm(s.filter_radius(), s.filter_sigma),
-                _ => 0.0,
-            },
+            filter_norm: pixel_filter::shader_norm(s.filter, s.filter_radius(), s.filter_sigma),
             _pad_filter: [0; 2],
         }
     }
