@@ -4,6 +4,7 @@
 use glam::{DVec3, Vec3};
 use mislab::accel::bvh::reference::{self, Ray, RefHit, Scene};
 use mislab::accel::bvh::{self, Bvh, EMPTY_CHILD};
+use mislab::accel::wide_bvh;
 use mislab::gpu::types::{make_prim, GpuQuad, GpuSphere, INVALID, PRIM_SPHERE, PRIM_TRIANGLE};
 use mislab::gpu::GpuContext;
 use mislab::testkit::probe::{GeometryBuffers, Probe, ProbeRay};
@@ -98,7 +99,7 @@ impl Geometry {
         bvh::build(&self.tris, &self.spheres, &self.quads, split(presplit))
     }
     fn build_wide(&self) -> Bvh {
-        bvh::build_wide(&self.tris, &self.spheres, &self.quads, split(true))
+        wide_bvh::build(&self.tris, &self.spheres, &self.quads, split(true))
     }
 }
 

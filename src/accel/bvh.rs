@@ -1,6 +1,6 @@
 //! BVH over triangles, spheres and quads: built on the CPU with obvhs (PLOC + reinsertion), flattened to the
-//! two-boxes-per-node layout that `shaders/bvh.wgsl` traverses; [`build_wide`] collapses it further into the 8-wide
-//! compressed layout of `crate::accel::wide_bvh` (the renderer's default).
+//! two-boxes-per-node layout that `shaders/bvh.wgsl` traverses; `crate::accel::wide_bvh::build` collapses it further into
+//! the 8-wide compressed layout (the renderer's default).
 //!
 //! Layout ([`GpuBvhNode`], WGSL `BvhNode`): every node stores the boxes of *both* children, so a traversal step
 //! tests two boxes from one 64-byte load and never fetches a child just to reject it. For each child:
@@ -19,8 +19,9 @@ use std::time::Instant;
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3, Vec3A};
 
+pub use crate::accel::aabb::{quad_aabb, sphere_aabb, triangle_aabb, Aabb};
 use crate::accel::presplit::{self, Piece};
-use crate::accel::wide_bvh::GpuWideNode;
+use crate::accel::wide_node::GpuWideNode;
 use crate::gpu::types::{
     make_prim, GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE, PRIM_TRIANGLE,
 };
@@ -125,97 +126,6 @@ pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
     order
 }
 
-/// An axis-aligned box (f32, as uploaded).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb {
-    pub min: Vec3,
-    pub max: Vec3,
-}
-
-impl Aabb {
-    /// The inverted box that unions to anything.
-    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::MAX), max: Vec3::splat(-f32::MAX) };
-
-    /// The smallest box holding both.
-    pub fn union(&self, o: &Aabb) -> Aabb {
-        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
-    }
-
-    /// Half the surface area, in f64 (a scene of extent 1e20 must not overflow the SAH sum).
-    pub fn half_area(&self) -> f64 {
-        let e = (self.max.as_dvec3() - self.min.as_dvec3()).max(DVec3::ZERO);
-        e.x * e.y + e.y * e.z + e.z * e.x
-    }
-
-    /// Whether `o` lies inside (inclusive).
-    pub fn contains(&self, o: &Aabb) -> bool {
-        self.min.cmple(o.min).all() && self.max.cmpge(o.max).all()
-    }
-}
-
-fn finite3(v: Vec3) -> bool {
-    v.is_finite()
-}
-
-/// The next f32 towards +inf / -inf (for rounding sphere and quad boxes outwards).
-pub(crate) fn next_up(x: f32) -> f32 {
-    if x.is_nan() || x == f32::INFINITY {
-        return x;
-    }
-    if x == 0.0 {
-        return f32::from_bits(1);
-    }
-    let b = x.to_bits();
-    f32::from_bits(if x > 0.0 { b + 1 } else { b - 1 })
-}
-
-pub(crate) fn next_down(x: f32) -> f32 {
-    -next_up(-x)
-}
-
-fn outward(min: Vec3, max: Vec3) -> Aabb {
-    Aabb {
-        min: Vec3::new(next_down(min.x), next_down(min.y), next_down(min.z)),
-        max: Vec3::new(next_up(max.x), next_up(max.y), next_up(max.z)),
-    }
-}
-
-/// The box of a triangle, or `None` if it is excluded from the BVH (non-finite, or exactly zero area: the edge
-/// cross product is evaluated in f64, where the products of f32 differences are exact).
-pub fn triangle_aabb(v: &[Vec3; 3]) -> Option<Aabb> {
-    if !v.iter().all(|p| finite3(*p)) {
-        return None;
-    }
-    let (a, b, c) = (v[0].as_dvec3(), v[1].as_dvec3(), v[2].as_dvec3());
-    if (b - a).cross(c - a) == DVec3::ZERO {
-        return None;
-    }
-    // Exact: the traversal tests the same f32 vertices.
-    Some(Aabb { min: v[0].min(v[1]).min(v[2]), max: v[0].max(v[1]).max(v[2]) })
-}
-
-/// The box of a sphere (rounded outwards), or `None` if excluded (non-finite, radius not > 0).
-pub fn sphere_aabb(s: &GpuSphere) -> Option<Aabb> {
-    let c = Vec3::from(s.center);
-    if !finite3(c) || s.radius.is_nan() || s.radius <= 0.0 || !s.radius.is_finite() {
-        return None;
-    }
-    let b = outward(c - s.radius, c + s.radius);
-    (finite3(b.min) && finite3(b.max)).then_some(b)
-}
-
-/// The box of a quad's four corners (rounded outwards), or `None` if excluded (non-finite, zero area).
-pub fn quad_aabb(q: &GpuQuad) -> Option<Aabb> {
-    let (p, u, v) = (Vec3::from(q.corner), Vec3::from(q.edge_u), Vec3::from(q.edge_v));
-    if !finite3(p) || !finite3(u) || !finite3(v) || u.as_dvec3().cross(v.as_dvec3()) == DVec3::ZERO {
-        return None;
-    }
-    let corners = [p, p + u, p + v, p + u + v];
-    let min = corners.iter().fold(Vec3::splat(f32::MAX), |m, c| m.min(*c));
-    let max = corners.iter().fold(Vec3::splat(-f32::MAX), |m, c| m.max(*c));
-    let b = outward(min, max);
-    (finite3(b.min) && finite3(b.max)).then_some(b)
-}
 
 /// obvhs build settings: its "slow" preset's PLOC search (24 neighbours), without obvhs's own pre-splits (mislab
 /// splits before, with conservative boxes: [`crate::accel::presplit`]), with leaves of at most 4 primitives
@@ -265,17 +175,8 @@ pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], 
     build_with(tri_verts, spheres, quads, presplit, false)
 }
 
-/// [`build`] collapsed to the 8-wide compressed layout ([`crate::accel::wide_bvh::widen`]). Where the wide tree of
-/// the PLOC build would be too deep for the traversal stack, the median split's tree (depth ≤ 31 for any input
-/// size the references allow) is widened instead.
-pub fn build_wide(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], presplit: Presplit) -> Bvh {
-    crate::accel::wide_bvh::widen(&build(tri_verts, spheres, quads, presplit)).unwrap_or_else(|| {
-        crate::accel::wide_bvh::widen(&build_with(tri_verts, spheres, quads, presplit, true))
-            .expect("a median-split tree is shallow enough to widen")
-    })
-}
-
-fn build_with(
+/// [`build`], or with `median` the median split's tree (shallow for any input: `wide_bvh::build` falls back to it).
+pub(crate) fn build_with(
     tri_verts: &[[Vec3; 3]],
     spheres: &[GpuSphere],
     quads: &[GpuQuad],

@@ -2,6 +2,7 @@
 //! compressed collapse), the convex solids of tiny scenes, the light tree over emitters and the convex lamps it
 //! treats as one light each.
 
+pub mod aabb;
 pub mod bvh;
 pub mod convex_lamps;
 pub mod convex_solids;
@@ -11,3 +12,4 @@ pub mod mesh_components;
 pub mod presplit;
 pub mod quantise;
 pub mod wide_bvh;
+pub mod wide_node;

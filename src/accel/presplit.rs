@@ -15,7 +15,7 @@ use std::collections::BinaryHeap;
 
 use glam::{DVec3, Vec3};
 
-use crate::accel::bvh::{next_down, next_up, Aabb};
+use crate::accel::aabb::{next_down, next_up, Aabb};
 
 /// Extra references allowed, as a fraction of the triangles (each costs a vertex copy of 48 bytes and a share
 /// of a node).

@@ -24,81 +24,18 @@
 //! (p − o)/d) and widens each plane by a bound on that form's roundings (`wide_node_hits`), so the wide tree finds
 //! the same closest hits.
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use crate::accel::bvh::{Aabb, Bvh, GpuBvhNode, BVH_STACK_SIZE, EMPTY_CHILD, MAX_LEAF_PRIMS};
-use crate::accel::quantise::{decode_frame, quantise, scale_exponent};
+use crate::accel::aabb::Aabb;
+use crate::accel::bvh::{self, Bvh, GpuBvhNode, Presplit, BVH_STACK_SIZE, EMPTY_CHILD, MAX_LEAF_PRIMS};
+use crate::accel::quantise::{quantise, scale_exponent};
+use crate::gpu::types::{GpuQuad, GpuSphere};
 
-/// One 8-wide node (WGSL `WideNode`, same field names); see the module docs.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuWideNode {
-    pub head: [u32; 4],
-    pub links: [u32; 4],
-    pub q_lo_xy: [u32; 4],
-    pub q_lo_z_hi_x: [u32; 4],
-    pub q_hi_yz: [u32; 4],
-}
+pub use crate::accel::wide_node::{GpuWideNode, WideChild, MAX_NODE_PRIMS, WIDTH};
 
-/// Children per node.
-pub const WIDTH: usize = 8;
-/// Primitive hit bits per node (bits 0–23 of the traversal's hit mask).
-pub const MAX_NODE_PRIMS: u32 = 24;
 /// Most wide levels: the traversal stack holds at most two entries per level (the rest of a node group and a
 /// postponed leaf group), so `2 · depth ≤ BVH_STACK_SIZE`.
 pub const MAX_WIDE_DEPTH: usize = BVH_STACK_SIZE / 2;
-
-/// A decoded child of a wide node (for tests and statistics).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum WideChild {
-    Empty,
-    /// An interior node: its index in the node list.
-    Interior(u32),
-    /// A leaf over `prim_refs[first..first + count]`.
-    Leaf {
-        first: u32,
-        count: u32,
-    },
-}
-
-impl GpuWideNode {
-    /// The origin `p` and the per-axis scale `s`.
-    pub fn frame(&self) -> (Vec3, Vec3) {
-        decode_frame(&self.head)
-    }
-
-    fn byte(words: &[u32], i: usize) -> u32 {
-        (words[i / 4] >> (8 * (i % 4))) & 0xff
-    }
-
-    /// The quantised box of slot `i`, decoded in f32 as the shader does.
-    pub fn child_box(&self, i: usize) -> Aabb {
-        let (p, s) = self.frame();
-        let b = |words: &[u32], j: usize| Self::byte(words, j) as f32;
-        let lo = Vec3::new(b(&self.q_lo_xy, i), b(&self.q_lo_xy, 8 + i), b(&self.q_lo_z_hi_x, i));
-        let hi = Vec3::new(b(&self.q_lo_z_hi_x, 8 + i), b(&self.q_hi_yz, i), b(&self.q_hi_yz, 8 + i));
-        Aabb { min: p + s * lo, max: p + s * hi }
-    }
-
-    /// Slot `i`'s meta byte.
-    pub fn meta(&self, i: usize) -> u32 {
-        Self::byte(&self.links[2..], i)
-    }
-
-    /// What slot `i` holds.
-    pub fn child(&self, i: usize) -> WideChild {
-        let m = self.meta(i);
-        let imask = self.head[3] >> 24;
-        if m == 0 {
-            WideChild::Empty
-        } else if m >> 5 == 0 {
-            WideChild::Interior(self.links[0] + (imask & ((1 << i) - 1)).count_ones())
-        } else {
-            WideChild::Leaf { first: self.links[1] + (m & 31), count: m >> 5 }
-        }
-    }
-}
 
 /// A BVH2 child: what the collapse moves between nodes. A leaf holds its primitive references themselves (up to
 /// [`MAX_LEAF_PRIMS`]): a small BVH2 subtree becomes one leaf, whose references need not be contiguous there.
@@ -367,6 +304,16 @@ fn assign_slots(kids: &[Child]) -> [Option<usize>; WIDTH] {
         }
     }
     slots
+}
+
+/// [`bvh::build`] collapsed to the 8-wide compressed layout ([`widen`]). Where the wide tree of
+/// the PLOC build would be too deep for the traversal stack, the median split's tree (depth ≤ 31 for any input
+/// size the references allow) is widened instead.
+pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], presplit: Presplit) -> Bvh {
+    widen(&bvh::build(tri_verts, spheres, quads, presplit)).unwrap_or_else(|| {
+        widen(&bvh::build_with(tri_verts, spheres, quads, presplit, true))
+            .expect("a median-split tree is shallow enough to widen")
+    })
 }
 
 /// Collapses a BVH2 into the wide layout. The result is a [`Bvh`] whose `wide` holds the nodes (root first) and

@@ -1,7 +1,7 @@
 //! SceneData: the scene flattened, on the CPU, into the tables the shaders read (geometry + BVH, shading
 //! data, light table, textures, environment distribution); `gpu_scene` uploads them.
 
-use crate::accel::bvh;
+use crate::accel::{bvh, wide_bvh};
 use crate::accel::light_tree::GpuLightNode;
 use crate::gpu::types::*;
 use crate::render::light_table;
@@ -236,7 +236,7 @@ impl SceneData {
         };
         let bvh_tris: Vec<[Vec3; 3]> = in_bvh.iter().map(|&i| tris[i]).collect();
         let presplit = if split.is_some() { bvh::Presplit::Off } else { presplit };
-        let mut bvh = bvh::build_wide(&bvh_tris, &d.spheres, &d.quads, presplit);
+        let mut bvh = wide_bvh::build(&bvh_tris, &d.spheres, &d.quads, presplit);
         // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs. The baked
         // occluders follow the BVH's triangles.
         d.triangles = tris.len();

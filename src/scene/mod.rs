@@ -9,7 +9,6 @@ pub mod gltf;
 pub mod import_build;
 pub mod import_material;
 pub mod import_texture;
-pub mod many_lights;
 pub mod mitsuba;
 pub mod named_spectra;
 pub mod obj;

@@ -1,5 +1,7 @@
 //! Built-in scenes, defined number for number (see `shared/scenes/*/README.md` and the lecture's area-vs-cosine slide).
 
+mod many_lights;
+
 use super::{Camera, Environment, Material, Mesh, Quad, Scene, Sphere};
 use glam::Vec3;
 
@@ -14,8 +16,8 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "cornell-box" => cornell_box(),
         "furnace" => furnace(),
         "area-vs-cosine" => area_vs_cosine(),
-        "many-lights" => super::many_lights::many_lights(),
-        "veach-mis-triangles" => super::many_lights::veach_mis_triangles(),
+        "many-lights" => many_lights::many_lights(),
+        "veach-mis-triangles" => many_lights::veach_mis_triangles(),
         _ => return None,
     };
     Some(scene)
@@ -239,7 +241,7 @@ fn area_vs_cosine() -> Scene {
 /// Area-weighted vertex normals from the triangles' winding (each triangle's normal points to the side it is
 /// counter-clockwise from). Unshared vertices therefore get flat face normals. Vertices used by no triangle, or only
 /// by degenerate ones, get +Y so that every normal stays unit length.
-pub(crate) fn vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+pub(super) fn vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
     let mut n = vec![Vec3::ZERO; positions.len()];
     for t in indices {
         let [a, b, c] = t.map(|i| positions[i as usize]);

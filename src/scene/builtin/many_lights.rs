@@ -2,8 +2,8 @@
 //! `veach-mis-triangles` (the lecture's Veach scene with its sphere lights tessellated, as the glTF version in
 //! `shared/scenes/veach-mis` has them), where which light a sample picks decides the noise.
 
-use super::builtin::{self, Builder};
-use super::{Camera, Material, Mesh, Scene};
+use super::{self as builtin, Builder};
+use crate::scene::{Camera, Material, Mesh, Scene};
 use glam::Vec3;
 
 /// The light tree's scene: 4096 small emissive triangles (0.12 units across) over a 40 × 40 Lambert 0.5 floor, on a
