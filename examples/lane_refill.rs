@@ -119,7 +119,7 @@ fn main() {
     let n: usize = std::env::args().nth(2).map(|s| s.parse().expect("RAYS")).unwrap_or(1 << 16);
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
     let tris = rays::triangles(&path);
-    let wide = bvh::build_wide(&tris, &[], &[], bvh::Presplit::Large { keep_whole: &[] });
+    let wide = mislab::accel::wide_bvh::build(&tris, &[], &[], bvh::Presplit::Large { keep_whole: &[] });
     let geo = GeometryBuffers::new(&ctx, &wide, &tris, &[], &[]);
     let library = mislab::testkit::probe::trace_module(KERNEL)
         .replace("override WIDE_BVH: bool = false;", "override WIDE_BVH: bool = true;");

@@ -97,14 +97,21 @@ impl RenderArgs {
     }
 }
 
-/// An error with the exit code it should produce.
+/// An error with the exit code it should produce. The library's layers return their own error types; here, at
+/// the command line, they all become one `anyhow::Error` to print.
 struct Failure {
     code: u8,
-    message: String,
+    error: anyhow::Error,
 }
 
-fn bad(message: impl Into<String>) -> Failure {
-    Failure { code: EXIT_BAD_INPUT, message: message.into() }
+/// Bad input (a file, a flag, a device that cannot do it): exit code 2.
+fn bad(error: impl Into<anyhow::Error>) -> Failure {
+    Failure { code: EXIT_BAD_INPUT, error: error.into() }
+}
+
+/// `bad` for the command line's own messages.
+fn bad_input(message: String) -> Failure {
+    bad(anyhow::anyhow!(message))
 }
 
 fn main() -> ExitCode {
@@ -134,20 +141,20 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => ExitCode::from(code),
         Err(f) => {
-            eprintln!("error: {}", f.message);
+            eprintln!("error: {}", f.error);
             ExitCode::from(f.code)
         }
     }
 }
 
 fn stress(filter: Option<&str>) -> Result<u8, Failure> {
-    let lab = api::Lab::open().map_err(|e| bad(e.to_string()))?;
+    let lab = api::Lab::open().map_err(bad)?;
     eprintln!("adapter: {}", lab.adapter());
     let outcomes =
         mislab::lab::stress::run(lab.gpu(), filter, |o| eprintln!("{}", mislab::lab::stress::progress_line(o)))
             .map_err(bad)?;
     if outcomes.is_empty() {
-        return Err(bad(format!("--filter '{}' matches no stress case", filter.unwrap_or_default())));
+        return Err(bad_input(format!("--filter '{}' matches no stress case", filter.unwrap_or_default())));
     }
     println!("{}", mislab::lab::stress::table(&outcomes));
     let failed = outcomes.iter().filter(|o| !o.pass).count();
@@ -165,7 +172,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     args.flags.settings.validate().map_err(bad)?;
     if !matches!(ext.as_deref(), Some("png") | Some("exr")) {
-        return Err(bad(format!("{}: unknown output format (use .png or .exr)", args.output.display())));
+        return Err(bad_input(format!("{}: unknown output format (use .png or .exr)", args.output.display())));
     }
     // Before any work: a missing directory or a read-only file would otherwise be found after the render.
     let target = mislab::io::output_file::check(&args.output, args.force).map_err(bad)?;
@@ -173,7 +180,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         eprintln!("note: --exposure is ignored for EXR output (linear radiance); it applies to PNG and the viewer");
     }
     // The flags and the state to resume first: a bad state file fails before any scene or device work.
-    let mut job = api::Job::new(&args.flags, Some(&args.output)).map_err(|e| bad(e.to_string()))?;
+    let mut job = api::Job::new(&args.flags, Some(&args.output)).map_err(bad)?;
     for note in &job.notes {
         eprintln!("note: {note}");
     }
@@ -199,12 +206,12 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         })
     };
     // The scene first: a bad file is reported without waiting for (or needing) a device.
-    let scene = api::SceneHandle::load(&args.scene).map_err(|e| bad(e.to_string()))?;
+    let scene = api::SceneHandle::load(&args.scene).map_err(bad)?;
     if let Some(code) = startup_interrupted() {
         return Ok(code);
     }
     let t_loaded = Instant::now();
-    let lab = api::Lab::open().map_err(|e| bad(e.to_string()))?;
+    let lab = api::Lab::open().map_err(bad)?;
     if let Some(code) = startup_interrupted() {
         return Ok(code);
     }
@@ -238,7 +245,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
             );
         },
     };
-    let image = api::render(&lab, &scene, &mut job, &mut observer).map_err(|e| bad(e.to_string()))?;
+    let image = api::render(&lab, &scene, &mut job, &mut observer).map_err(bad)?;
     observer.bar.finish_and_clear();
     let stats = &image.stats;
     if stats.interrupted && stats.spp == 0 {
@@ -249,7 +256,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
     if let Some(path) = job.state_path() {
         eprintln!("wrote state {} (samples {}..{})", path.display(), image.sample_range.0, image.sample_range.1);
     }
-    image.save_to(&target, args.tonemap).map_err(|e| bad(e.to_string()))?;
+    image.save_to(&target, args.tonemap).map_err(bad)?;
     let extra = if stats.extra_rows > 0 {
         format!(" (and one more in {} of {} rows)", stats.extra_rows, settings.height)
     } else {
@@ -317,10 +324,10 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
     for a in api::adapters() {
         println!("  {a}");
     }
-    let lab = api::Lab::open().map_err(|e| bad(e.to_string()))?;
+    let lab = api::Lab::open().map_err(bad)?;
     print!("chosen {}", lab.describe());
     if let Some(name) = scene_name {
-        let scene = api::SceneHandle::named(&name).map_err(|e| bad(e.to_string()))?;
+        let scene = api::SceneHandle::named(&name).map_err(bad)?;
         for line in scene.report(&lab) {
             println!("{line}");
         }

@@ -806,7 +806,7 @@ fn bench_end_to_end_from_flags() {
     let png = dir.join("ref.png");
     image::RgbImage::new(24, 16).save(&png).unwrap();
     let e = mislab::lab::bench::run(&with_ref(&png, &again).args).unwrap_err();
-    assert!(e.contains("not an OpenEXR file"), "{e}");
+    assert!(e.to_string().contains("not an OpenEXR file"), "{e}");
 }
 
 /// A TOML configuration with two groups, one reading the reference the other wrote.

@@ -252,7 +252,7 @@ fn corrupted_truncated_and_foreign_state_files_are_refused_with_exit_2() {
         let p = d.join(name);
         std::fs::write(&p, data).unwrap();
         let e = RenderState::read(&p).unwrap_err();
-        assert!(e.contains(name) && e.contains(why), "{name}: {e}");
+        assert!(e.to_string().contains(name) && e.to_string().contains(why), "{name}: {e}");
         // The binary refuses it before it needs a GPU or the scene: exit 2, the file named.
         let (code, t) =
             run_code(bin().args(["render", "--width", "8", "--height", "4", "--spp", "16", "--resume"]).arg(&p));

@@ -284,7 +284,7 @@ fn read_image<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Bound<'py, PyByt
     if path.symlink_metadata().is_err() {
         return Err(PyFileNotFoundError::new_err(format!("{}: no such file", path.display())));
     }
-    let img = mislab::lab::compare::read(&path).map_err(PyValueError::new_err)?;
+    let img = mislab::lab::compare::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok((floats(py, &img.pixels)?, img.width, img.height))
 }
 
@@ -316,7 +316,7 @@ fn compare(
 ) -> PyResult<String> {
     let a = pixels_of(image, width, height)?;
     let b = pixels_of(reference, ref_width, ref_height)?;
-    let c = mislab::lab::compare::compare(&a, &b, block).map_err(PyValueError::new_err)?;
+    let c = mislab::lab::compare::compare(&a, &b, block).map_err(|e| PyValueError::new_err(e.to_string()))?;
     serde_json::to_string(&c).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
@@ -354,7 +354,7 @@ fn bench_group(
     let scene = scene.inner.scene();
     let rows = py
         .detach(|| mislab::lab::bench::run_configurations(lab.gpu(), &g, scene, &reference))
-        .map_err(PyValueError::new_err)?;
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
     serde_json::to_string(&rows.0).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 

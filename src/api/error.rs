@@ -2,7 +2,10 @@
 //! with the message; Python raises `ValueError` (Settings), `FileNotFoundError` (NotFound), `mislab.SceneError`
 //! (Scene) or `RuntimeError` (the rest).
 
-use crate::render::RenderError;
+use crate::io::output_file::OutputError;
+use crate::render::{InvalidSettings, RenderError};
+use crate::scene::LoadError;
+use crate::state::StateError;
 
 /// An error from the embeddable API.
 #[derive(Debug, thiserror::Error)]
@@ -14,8 +17,11 @@ pub enum ApiError {
     #[error("{0}")]
     NotFound(String),
     /// A scene file that cannot be loaded (the message names the file, and the line for text formats).
+    #[error(transparent)]
+    Scene(#[from] LoadError),
+    /// A scene that loaded but does not fit the device.
     #[error("{0}")]
-    Scene(String),
+    Upload(String),
     /// No usable device, or the device failed.
     #[error("{0}")]
     Device(String),
@@ -23,22 +29,21 @@ pub enum ApiError {
     #[error(transparent)]
     Render(#[from] RenderError),
     /// A state file (checkpoint, part, resume) could not be read, used or written.
-    #[error("{0}")]
-    State(String),
+    #[error(transparent)]
+    State(#[from] StateError),
     /// The image could not be written.
-    #[error("{0}")]
-    Output(String),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+impl From<InvalidSettings> for ApiError {
+    fn from(e: InvalidSettings) -> ApiError {
+        ApiError::Settings(e.0)
+    }
 }
 
 impl From<crate::gpu::GpuError> for ApiError {
     fn from(e: crate::gpu::GpuError) -> ApiError {
         ApiError::Device(e.to_string())
-    }
-}
-
-/// Layers above that still speak in messages take an API error as its message.
-impl From<ApiError> for String {
-    fn from(e: ApiError) -> String {
-        e.to_string()
     }
 }

@@ -94,7 +94,7 @@ impl RenderFlags {
             (Some(0), _) => Err(ApiError::Settings("--spp must be at least 1".into())),
             (Some(n), _) => {
                 // Hammersley and stratified build their points for a fixed count: refuse or round with a message.
-                let used = crate::render::samplers::check_spp(self.settings.sampler, n).map_err(ApiError::Settings)?;
+                let used = crate::render::samplers::check_spp(self.settings.sampler, n)?;
                 let note = crate::render::samplers::spp_message(self.settings.sampler, n, used);
                 Ok((Budget::Samples(used), (!note.is_empty()).then_some(note)))
             }

@@ -68,13 +68,13 @@ impl Image {
     /// Writes PNG (tonemapped with the settings' exposure) or EXR (linear) by the extension of `path`, with the
     /// header attributes; refuses to replace a read-only file unless `force`.
     pub fn save(&self, path: &Path, tonemap: Tonemap, force: bool) -> Result<(), ApiError> {
-        let target = crate::io::output_file::check(path, force).map_err(ApiError::Output)?;
+        let target = crate::io::output_file::check(path, force)?;
         self.save_to(&target, tonemap)
     }
 
     /// `save` to an output already checked (the CLI checks before rendering).
     pub fn save_to(&self, target: &crate::io::output_file::OutputTarget, tonemap: Tonemap) -> Result<(), ApiError> {
-        self.film.save_to(target, self.settings.exposure, tonemap, &self.attributes()).map_err(ApiError::Output)
+        self.film.save_to(target, self.settings.exposure, tonemap, &self.attributes()).map_err(ApiError::from)
     }
 }
 

@@ -6,6 +6,7 @@ use super::error::ApiError;
 use super::flags::RenderFlags;
 use super::scene::SceneHandle;
 use crate::render::samplers::check_spp;
+use crate::state::StateError;
 use crate::render::settings::{Mode, PixelFilter, SamplerKind, Settings};
 use crate::state::session::Session;
 use crate::state::StateHeader;
@@ -39,8 +40,8 @@ impl Job {
     /// Checks `flags` and opens the state to resume, if any. `output` is the image the CLI writes: its name with
     /// `.state` is the default state file; without it, state flags need `state` (or `resume`) to name one.
     pub fn new(flags: &RenderFlags, output: Option<&Path>) -> Result<Job, ApiError> {
-        flags.settings.validate().map_err(ApiError::Settings)?;
-        let session = Session::open(&flags.state, flags.spp, output).map_err(ApiError::State)?;
+        flags.settings.validate()?;
+        let session = Session::open(&flags.state, flags.spp, output)?;
         let resumed = session.as_ref().and_then(|s| s.resumed_header().map(|h| (s.path(), h)));
         let flags = match resumed {
             Some((path, saved)) => resume_defaults(flags, path, saved)?,
@@ -73,7 +74,7 @@ impl Job {
 
     /// A job of `settings` to `budget`, with no state file (the lab's tools, which choose settings themselves).
     pub fn of(settings: Settings, budget: Budget) -> Result<Job, ApiError> {
-        settings.validate().map_err(ApiError::Settings)?;
+        settings.validate()?;
         Ok(Job {
             settings,
             budget,
@@ -180,11 +181,12 @@ impl Job {
 /// difference (the scene's too).
 fn resume_defaults(flags: &RenderFlags, path: &Path, saved: &StateHeader) -> Result<RenderFlags, ApiError> {
     if flags.time.is_some() {
-        return Err(ApiError::State(format!(
+        return Err(StateError::Flags(format!(
             "{}: a resumed render continues to the state's sample count ({} spp): --time cannot be given",
             path.display(),
             saved.spp_total
-        )));
+        ))
+        .into());
     }
     let map = |s: &Settings| match serde_json::to_value(s) {
         Ok(serde_json::Value::Object(m)) => m,
@@ -198,8 +200,8 @@ fn resume_defaults(flags: &RenderFlags, path: &Path, saved: &StateHeader) -> Res
         }
     }
     let settings: Settings = serde_json::from_value(serde_json::Value::Object(merged))
-        .map_err(|e| ApiError::State(format!("{}: the state's settings cannot be read: {e}", path.display())))?;
-    settings.validate().map_err(|e| ApiError::State(format!("{}: {e}", path.display())))?;
+        .map_err(|e| invalid_state(path, format!("its settings cannot be read: {e}")))?;
+    settings.validate().map_err(|e| invalid_state(path, e.0))?;
     Ok(RenderFlags { spp: Some(flags.spp.unwrap_or(saved.spp_total)), settings, ..flags.clone() })
 }
 
@@ -211,4 +213,9 @@ fn non_default_settings(settings: &Settings) -> Vec<String> {
     };
     let default = map(&Settings::default());
     map(settings).into_iter().filter(|(k, v)| default.get(k) != Some(v)).map(|(k, _)| k).collect()
+}
+
+/// A state file whose header this mislab cannot use.
+fn invalid_state(path: &Path, problem: String) -> ApiError {
+    StateError::Invalid { file: path.display().to_string(), problem }.into()
 }

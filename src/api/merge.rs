@@ -16,11 +16,11 @@ pub fn merge(paths: &[PathBuf], state: Option<&Path>) -> Result<Image, ApiError>
         .iter()
         .map(|p| RenderState::read(p).map(|state| Part { path: p.clone(), state }))
         .collect::<Result<Vec<_>, _>>()
-        .map_err(ApiError::State)?;
-    let parts = check_parts(parts).map_err(ApiError::State)?;
+        ?;
+    let parts = check_parts(parts)?;
     let merged = merge_parts(&parts);
     if let Some(path) = state {
-        merged.write(path).map_err(ApiError::State)?;
+        merged.write(path)?;
     }
     let h = &merged.header;
     Ok(Image {

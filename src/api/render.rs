@@ -26,7 +26,7 @@ pub fn render(lab: &Lab, scene: &SceneHandle, job: &mut Job, observer: &mut dyn 
     let mut dispatch = job.dispatch_spp.unwrap_or_else(|| r.renderer.max_dispatch_spp());
     loop {
         let mut save = |renderer: &Renderer, seconds: f64| match &job.session {
-            Some(s) => s.save(lab.gpu(), renderer, seconds).map_err(ApiError::State),
+            Some(s) => s.save(lab.gpu(), renderer, seconds).map_err(ApiError::from),
             None => Ok(()),
         };
         let checkpoint = job.session.as_ref().and_then(|s| s.every()).map(|every| (every, &mut save as SaveCheckpoint));
@@ -51,7 +51,7 @@ pub fn render(lab: &Lab, scene: &SceneHandle, job: &mut Job, observer: &mut dyn 
     if let Some(s) = &job.session {
         // Nothing to save when a stop came before the first sample: the state on disk is still right.
         if !(r.stats.interrupted && r.stats.spp == 0) {
-            s.save(lab.gpu(), &r.renderer, r.stats.seconds).map_err(ApiError::State)?;
+            s.save(lab.gpu(), &r.renderer, r.stats.seconds).map_err(ApiError::from)?;
         }
     }
     r.image(lab)
@@ -93,7 +93,7 @@ impl Render {
         renderer.set_dispatch_spp(job.dispatch_spp);
         if let (Some(s), Budget::Samples(n)) = (job.session.as_mut(), job.budget) {
             s.start(&mut renderer, &scene.spec().scene, scene.hash().to_string(), &settings, n, n)
-                .map_err(ApiError::State)?;
+                .map_err(ApiError::from)?;
         }
         ctx.wait()?;
         observer.started(t0.elapsed().as_secs_f64());

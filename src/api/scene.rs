@@ -4,7 +4,7 @@
 use super::error::ApiError;
 use super::lab::Lab;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
-use crate::scene::{self, Camera, Scene, SceneSpec};
+use crate::scene::{self, Camera, LoadError, Scene, SceneSpec};
 use std::sync::{Arc, Mutex};
 
 /// A loaded scene, ready to render any number of times with any settings.
@@ -21,14 +21,16 @@ impl SceneHandle {
     /// Loads a scene as the command line names it (a .gltf/.glb/.toml/.pbrt/.xml file or a built-in name, with
     /// an environment override) and builds its device data (BVH, light tables). Loader warnings go to stderr.
     pub fn load(spec: &SceneSpec) -> Result<SceneHandle, ApiError> {
-        let scene = spec.load().map_err(|message| {
+        let scene = spec.load(crate::gpu::chosen_adapter_storage_limit()).map_err(|e| {
             let missing = scene::builtin::by_name(&spec.scene).is_none()
                 && std::path::Path::new(&spec.scene).symlink_metadata().is_err();
             let env_missing = spec.env.as_ref().is_some_and(|p| p.symlink_metadata().is_err());
             if missing || env_missing {
-                ApiError::NotFound(message)
+                ApiError::NotFound(e.to_string())
+            } else if let LoadError::Flag(m) = e {
+                ApiError::Settings(m)
             } else {
-                ApiError::Scene(message)
+                ApiError::Scene(e)
             }
         })?;
         let data = SceneData::build(&scene);
@@ -110,7 +112,7 @@ impl SceneHandle {
             }
         }
         let gpu = GpuScene::upload(lab.gpu(), self.data.clone())
-            .map_err(|e| ApiError::Scene(format!("{}: {e}", self.spec.scene)))?;
+            .map_err(|e| ApiError::Upload(format!("{}: {e}", self.spec.scene)))?;
         let gpu = Arc::new(gpu);
         *slot = Some((lab.id, gpu.clone()));
         Ok(gpu)

@@ -4,6 +4,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+pub use crate::io::error::ImageReadError;
+use crate::io::error::OutputError;
+
 fn text(s: &str) -> exr::meta::attribute::Text {
     use exr::meta::attribute::Text;
     Text::new_or_none(s).unwrap_or_else(|| {
@@ -20,12 +23,12 @@ pub struct Pixels<'a> {
 
 /// Writes linear RGB float32 EXR with `attributes` as text attributes of the layer (written to a temporary
 /// file and renamed; see `output_file`).
-pub fn write(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Result<(), String> {
+pub fn write(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Result<(), OutputError> {
     crate::io::output_file::check(path, true)?.write(|tmp| encode(tmp, image, attributes))
 }
 
 /// Encodes `image` as linear RGB float32 EXR at `path`, with `attributes` as text attributes of the layer.
-pub fn encode(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Result<(), String> {
+pub fn encode(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Result<(), exr::error::Error> {
     use exr::prelude::*;
     let (w, h) = (image.width as usize, image.height as usize);
     let mut layer_attributes = LayerAttributes::named("mislab");
@@ -43,7 +46,7 @@ pub fn encode(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Re
             (c[0], c[1], c[2])
         }),
     );
-    Image::from_layer(layer).write().to_file(path).map_err(|e| format!("EXR: {e}"))
+    Image::from_layer(layer).write().to_file(path)
 }
 
 /// A reference read back: size, linear RGB pixels, and its text attributes.
@@ -62,18 +65,14 @@ pub struct ReferenceImage {
 /// Reads a linear image from an OpenEXR file (any writer) and, where present, the text attributes `write`
 /// records. Anything else is refused: an 8-bit PNG or JPEG is tonemapped and clipped, and an error measured
 /// against it would be silently meaningless.
-pub fn read(path: &Path) -> Result<ReferenceImage, String> {
+pub fn read(path: &Path) -> Result<ReferenceImage, ImageReadError> {
     let bytes = crate::io::input_file::read_bounded(path, crate::io::input_file::MAX_ENVMAP_BYTES)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+        .map_err(|source| ImageReadError::Input { path: path.into(), source })?;
     if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        return Err(format!(
-            "{}: not an OpenEXR file; a reference must be linear EXR (e.g. from `mislab reference`) or a .state, \
-             not a tonemapped 8-bit image",
-            path.display()
-        ));
+        return Err(ImageReadError::NotExr { path: path.into() });
     }
     let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::OpenExr)
-        .map_err(|e| format!("{}: {e}", path.display()))?
+        .map_err(|e| ImageReadError::Decode { path: path.into(), message: e.to_string() })?
         .into_rgb32f();
     let (width, height) = img.dimensions();
     let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();

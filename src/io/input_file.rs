@@ -14,6 +14,8 @@ use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+pub use crate::io::error::InputError;
+
 const MIB: u64 = 1 << 20;
 /// TOML scene files: text written by hand or by scripts; far larger is a mistake (or an attack).
 pub const MAX_TOML_BYTES: u64 = 64 * MIB;
@@ -26,11 +28,6 @@ pub const MAX_ENVMAP_BYTES: u64 = 2048 * MIB;
 /// pbrt / Mitsuba scene text and the meshes and images they reference, and what a gzip'd mesh (`.ply.gz`)
 /// inflates to: the limit counts the inflated bytes, so a "zip bomb" stops there (`read_limited`).
 pub const MAX_IMPORT_BYTES: u64 = MAX_GLTF_BYTES;
-
-/// Human size for messages: "12.0 MiB (12582912 bytes)".
-fn size(bytes: u64) -> String {
-    format!("{:.1} MiB ({bytes} bytes)", bytes as f64 / MIB as f64)
-}
 
 /// What a non-regular file is, for the message.
 fn kind_of(ft: &std::fs::FileType) -> &'static str {
@@ -57,31 +54,26 @@ fn kind_of(ft: &std::fs::FileType) -> &'static str {
     }
 }
 
-/// The message for an I/O error on opening or inspecting `path`.
-fn describe_io(path: &Path, e: &std::io::Error) -> String {
+/// What an I/O error on opening or inspecting `path` means.
+fn describe_io(path: &Path, e: std::io::Error) -> InputError {
     // ELOOP: a symlink cycle (or a chain longer than the system follows).
     #[cfg(target_os = "linux")]
     if e.raw_os_error() == Some(40) {
-        return "is a symbolic link loop (too many levels of symbolic links)".into();
+        return InputError::LinkLoop;
     }
     match e.kind() {
-        std::io::ErrorKind::NotFound if path.symlink_metadata().is_ok() => {
-            "is a symbolic link to a file that does not exist".into()
-        }
-        std::io::ErrorKind::NotFound => "no such file".into(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
-        _ => format!("cannot be read: {e}"),
+        std::io::ErrorKind::NotFound if path.symlink_metadata().is_ok() => InputError::DanglingLink,
+        std::io::ErrorKind::NotFound => InputError::NotFound,
+        std::io::ErrorKind::PermissionDenied => InputError::PermissionDenied,
+        _ => InputError::Read(e),
     }
 }
 
 /// Opens `path` for reading if it is a regular file (after following symlinks); returns it and its size.
-pub fn open_regular(path: &Path) -> Result<(File, u64), String> {
-    let meta = std::fs::metadata(path).map_err(|e| describe_io(path, &e))?;
+pub fn open_regular(path: &Path) -> Result<(File, u64), InputError> {
+    let meta = std::fs::metadata(path).map_err(|e| describe_io(path, e))?;
     let via_link = path.symlink_metadata().is_ok_and(|m| m.file_type().is_symlink());
-    let not_regular = |ft: &std::fs::FileType| {
-        let link = if via_link { " (through a symbolic link)" } else { "" };
-        format!("is {}{link}, not a regular file", kind_of(ft))
-    };
+    let not_regular = |ft: &std::fs::FileType| InputError::NotRegular { kind: kind_of(ft), via_link };
     if !meta.is_file() {
         return Err(not_regular(&meta.file_type()));
     }
@@ -93,8 +85,8 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), String> {
         // Non-blocking: a FIFO put in the file's place after the check above must not block the open.
         options.custom_flags(libc::O_NONBLOCK);
     }
-    let file = options.open(path).map_err(|e| describe_io(path, &e))?;
-    let meta = file.metadata().map_err(|e| describe_io(path, &e))?;
+    let file = options.open(path).map_err(|e| describe_io(path, e))?;
+    let meta = file.metadata().map_err(|e| describe_io(path, e))?;
     if !meta.is_file() {
         return Err(not_regular(&meta.file_type()));
     }
@@ -103,14 +95,14 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), String> {
 
 /// Reads a whole regular file of at most `limit` bytes (see `open_regular`), refusing larger ones before
 /// reading them and never reading more than `limit` bytes however the file changes meanwhile.
-pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
     let (file, len) = open_regular(path)?;
-    let over = |n: u64| format!("is {}, over the limit of {} for this kind of input", size(n), size(limit));
+    let over = |bytes: u64| InputError::TooLarge { bytes, limit };
     if len > limit {
         return Err(over(len));
     }
     let mut bytes = Vec::with_capacity(len as usize);
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| format!("cannot be read: {e}"))?;
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(InputError::Read)?;
     if bytes.len() as u64 > limit {
         return Err(over(bytes.len() as u64));
     }
@@ -119,18 +111,18 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
 
 /// The first `max` bytes of a regular file (all of it when shorter): for inputs that declare their own
 /// length, such as glTF buffers, which may be followed by more data that is not read.
-pub fn read_prefix(path: &Path, max: u64) -> Result<Vec<u8>, String> {
+pub fn read_prefix(path: &Path, max: u64) -> Result<Vec<u8>, InputError> {
     let (file, len) = open_regular(path)?;
     let mut bytes = Vec::with_capacity(len.min(max) as usize);
-    file.take(max).read_to_end(&mut bytes).map_err(|e| format!("cannot be read: {e}"))?;
+    file.take(max).read_to_end(&mut bytes).map_err(InputError::Read)?;
     Ok(bytes)
 }
 
 /// Reads `reader` to its end if that is at most `limit` bytes, growing the buffer step by step (never past the
 /// limit, and never by an allocation that fails: that is an error too) so that a stream that never ends, such as
 /// a gzip "zip bomb", costs at most `limit` bytes of memory before the error.
-pub fn read_limited(mut reader: impl Read, limit: u64) -> Result<Vec<u8>, String> {
-    let over = || format!("inflates to more than {}, the limit for this kind of input", size(limit));
+pub fn read_limited(mut reader: impl Read, limit: u64) -> Result<Vec<u8>, InputError> {
+    let over = || InputError::InflatesTooLarge { limit };
     let mut bytes: Vec<u8> = Vec::new();
     let mut chunk = vec![0u8; 1 << 16];
     loop {
@@ -138,7 +130,7 @@ pub fn read_limited(mut reader: impl Read, limit: u64) -> Result<Vec<u8>, String
             Ok(0) => return Ok(bytes),
             Ok(n) => n,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(format!("cannot be read: {e}")),
+            Err(e) => return Err(InputError::Read(e)),
         };
         if (bytes.len() + n) as u64 > limit {
             return Err(over());
@@ -146,9 +138,8 @@ pub fn read_limited(mut reader: impl Read, limit: u64) -> Result<Vec<u8>, String
         if bytes.capacity() - bytes.len() < n {
             // Double, but never past the limit.
             let want = (bytes.capacity() * 2).max(1 << 20).min(limit as usize) - bytes.len();
-            bytes.try_reserve_exact(want.max(n)).map_err(|_| {
-                format!("needs more memory than is available (at {} inflated)", size(bytes.len() as u64))
-            })?;
+            let at = bytes.len() as u64;
+            bytes.try_reserve_exact(want.max(n)).map_err(|_| InputError::OutOfMemory { at })?;
         }
         bytes.extend_from_slice(&chunk[..n]);
     }
@@ -210,10 +201,10 @@ pub fn resolve_inside(base: &Path, rel: &Path, allow_outside: bool) -> Result<Pa
 }
 
 /// `read_bounded` for UTF-8 text.
-pub fn read_bounded_text(path: &Path, limit: u64) -> Result<String, String> {
+pub fn read_bounded_text(path: &Path, limit: u64) -> Result<String, InputError> {
     let bytes = read_bounded(path, limit)?;
     String::from_utf8(bytes)
-        .map_err(|e| format!("is not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()))
+        .map_err(|e| InputError::NotUtf8 { offset: e.utf8_error().valid_up_to() })
 }
 
 /// Cuts text echoed from an input (a key, a name, a URI) to at most `max` characters, marking the cut.
@@ -258,11 +249,11 @@ mod tests {
     #[test]
     fn refuses_what_is_not_a_regular_file() {
         let e = read_bounded(Path::new("/dev/zero"), 1 << 20).unwrap_err();
-        assert!(e.contains("character device"), "{e}");
+        assert!(e.to_string().contains("character device"), "{e}");
         let e = read_bounded(Path::new("/"), 1 << 20).unwrap_err();
-        assert!(e.contains("a directory"), "{e}");
+        assert!(e.to_string().contains("a directory"), "{e}");
         let e = read_bounded(Path::new("/no/such/file"), 1 << 20).unwrap_err();
-        assert_eq!(e, "no such file");
+        assert!(matches!(e, InputError::NotFound), "{e}");
     }
 
     #[test]
@@ -273,7 +264,7 @@ mod tests {
         std::fs::write(&p, b"secretsecr").unwrap();
         assert_eq!(read_bounded(&p, 10).unwrap().len(), 10);
         let e = read_bounded(&p, 9).unwrap_err();
-        assert!(e.contains("over the limit") && !e.contains("secret"), "{e}");
+        assert!(e.to_string().contains("over the limit") && !e.to_string().contains("secret"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -281,7 +272,7 @@ mod tests {
     fn read_limited_stops_an_endless_stream() {
         let zeros = std::io::repeat(0).take(10 << 20);
         let e = read_limited(zeros, 1 << 20).unwrap_err();
-        assert!(e.contains("more than 1.0 MiB"), "{e}");
+        assert!(e.to_string().contains("more than 1.0 MiB"), "{e}");
         assert_eq!(read_limited(&b"abc"[..], 3).unwrap(), b"abc");
     }
 

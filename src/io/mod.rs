@@ -1,6 +1,7 @@
 //! Files in and out: opening inputs safely, writing outputs atomically, EXR images, and command-line values.
 
 pub mod cli_values;
+pub mod error;
 pub mod exr_image;
 pub mod input_file;
 pub mod output_file;

@@ -8,6 +8,8 @@
 
 use std::path::{Path, PathBuf};
 
+pub use crate::io::error::OutputError;
+
 /// Longest file name most file systems allow (bytes).
 const MAX_NAME_BYTES: usize = 255;
 
@@ -22,29 +24,24 @@ pub struct OutputTarget {
 }
 
 /// Checks that `path` can be written (see the module documentation), before any work is done.
-pub fn check(path: &Path, force: bool) -> Result<OutputTarget, String> {
-    let shown = path.display();
-    let name = path.file_name().ok_or_else(|| format!("{shown}: the output path names no file"))?;
+pub fn check(path: &Path, force: bool) -> Result<OutputTarget, OutputError> {
+    let path_buf = || path.to_path_buf();
+    let name = path.file_name().ok_or_else(|| OutputError::NoFileName { path: path_buf() })?;
     if name.len() > MAX_NAME_BYTES {
-        return Err(format!(
-            "{shown}: the output file name is {} bytes, longer than the {MAX_NAME_BYTES} a file system allows",
-            name.len()
-        ));
+        return Err(OutputError::NameTooLong { path: path_buf(), bytes: name.len(), max: MAX_NAME_BYTES });
     }
     let file = resolve_links(path)?;
     match std::fs::metadata(&file) {
-        Ok(m) if m.is_dir() => return Err(format!("{shown}: the output path is a directory")),
-        Ok(m) if !m.is_file() => return Err(format!("{shown}: the output path exists and is not a regular file")),
-        Ok(m) if m.permissions().readonly() && !force => {
-            return Err(format!("{shown}: the output file is read-only; pass --force to replace it"))
-        }
+        Ok(m) if m.is_dir() => return Err(OutputError::IsDirectory { path: path_buf() }),
+        Ok(m) if !m.is_file() => return Err(OutputError::NotRegular { path: path_buf() }),
+        Ok(m) if m.permissions().readonly() && !force => return Err(OutputError::ReadOnly { path: path_buf() }),
         _ => {}
     }
     let dir = parent_of(&file);
     match std::fs::metadata(&dir) {
         Ok(m) if m.is_dir() => {}
-        Ok(_) => return Err(format!("{shown}: {} is not a directory", dir.display())),
-        Err(_) => return Err(format!("{shown}: the output directory {} does not exist", dir.display())),
+        Ok(_) => return Err(OutputError::ParentNotDirectory { path: path_buf(), dir }),
+        Err(_) => return Err(OutputError::NoDirectory { path: path_buf(), dir }),
     }
     // Creating (and removing) the temporary file now finds an unwritable directory before the render.
     let probe = temp_path(&file);
@@ -52,7 +49,7 @@ pub fn check(path: &Path, force: bool) -> Result<OutputTarget, String> {
         .write(true)
         .create_new(true)
         .open(&probe)
-        .map_err(|e| format!("{shown}: cannot write in {}: {e}", dir.display()))?;
+        .map_err(|source| OutputError::Unwritable { path: path_buf(), dir: dir.clone(), source })?;
     let _ = std::fs::remove_file(&probe);
     Ok(OutputTarget { given: path.to_path_buf(), file })
 }
@@ -67,18 +64,19 @@ fn parent_of(file: &Path) -> PathBuf {
 
 /// Follows a chain of symlinks at `path` (at most 40, as the kernel does) to the file it names, which may
 /// not exist yet.
-fn resolve_links(path: &Path) -> Result<PathBuf, String> {
+fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     let mut file = path.to_path_buf();
     for _ in 0..40 {
         match std::fs::symlink_metadata(&file) {
             Ok(m) if m.file_type().is_symlink() => {
-                let target = std::fs::read_link(&file).map_err(|e| format!("{}: {e}", path.display()))?;
+                let target =
+                    std::fs::read_link(&file).map_err(|source| OutputError::Link { path: path.into(), source })?;
                 file = parent_of(&file).join(target);
             }
             _ => return Ok(file),
         }
     }
-    Err(format!("{}: the output path is a symbolic link loop", path.display()))
+    Err(OutputError::LinkLoop { path: path.into() })
 }
 
 /// A temporary name next to `file`: hidden, unique to this process.
@@ -90,10 +88,14 @@ fn temp_path(file: &Path) -> PathBuf {
 /// Replaces `file` by what `write` creates at a temporary path beside it: write, fsync the file, rename over
 /// `file`, fsync the directory (so the rename itself survives a crash). A kill or a full disk at any moment
 /// leaves the old file or the new one, never a torn one; a failed write leaves no temporary behind. The one
-/// way mislab writes its outputs (images, figures, state files).
-pub fn replace_atomically(file: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+/// way mislab writes its outputs (images, figures, state files). The error is the writer's message, or the
+/// file system's.
+pub fn replace_atomically<E: std::fmt::Display>(
+    file: &Path,
+    write: impl FnOnce(&Path) -> Result<(), E>,
+) -> Result<(), String> {
     let tmp = temp_path(file);
-    let result = write(&tmp).and_then(|()| {
+    let result = write(&tmp).map_err(|e| e.to_string()).and_then(|()| {
         let synced = std::fs::OpenOptions::new().write(true).open(&tmp).and_then(|f| f.sync_all());
         synced.and_then(|()| std::fs::rename(&tmp, file)).map_err(|e| e.to_string())?;
         // Directories cannot be opened for syncing everywhere; the rename is done either way.
@@ -110,9 +112,8 @@ pub fn replace_atomically(file: &Path, write: impl FnOnce(&Path) -> Result<(), S
 
 impl OutputTarget {
     /// Writes the output through `write` (given the temporary path to create) and renames it into place.
-    pub fn write(&self, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
-        replace_atomically(&self.file, write)
-            .map_err(|e| format!("{}: could not write the image: {e}", self.given.display()))
+    pub fn write<E: std::fmt::Display>(&self, write: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), OutputError> {
+        replace_atomically(&self.file, write).map_err(|message| OutputError::Write { path: self.given.clone(), message })
     }
 }
 
@@ -126,14 +127,14 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(dir.join("sub")).unwrap();
         let e = check(&dir.join("missing/x.png"), false).unwrap_err();
-        assert!(e.contains("does not exist"), "{e}");
+        assert!(e.to_string().contains("does not exist"), "{e}");
         let e = check(&dir.join("sub"), false).unwrap_err();
-        assert!(e.contains("is a directory"), "{e}");
+        assert!(e.to_string().contains("is a directory"), "{e}");
         std::fs::write(dir.join("file"), b"x").unwrap();
         let e = check(&dir.join("file/x.png"), false).unwrap_err();
-        assert!(e.contains("is not a directory"), "{e}");
+        assert!(e.to_string().contains("is not a directory"), "{e}");
         let e = check(&dir.join(format!("{}.png", "a".repeat(300))), false).unwrap_err();
-        assert!(e.contains("longer than"), "{e}");
+        assert!(e.to_string().contains("longer than"), "{e}");
 
         // Read-only: refused, unless forced.
         let ro = dir.join("ro.png");
@@ -141,7 +142,7 @@ mod tests {
         let mut perm = std::fs::metadata(&ro).unwrap().permissions();
         perm.set_readonly(true);
         std::fs::set_permissions(&ro, perm).unwrap();
-        assert!(check(&ro, false).unwrap_err().contains("read-only"));
+        assert!(check(&ro, false).unwrap_err().to_string().contains("read-only"));
         check(&ro, true).unwrap().write(|p| std::fs::write(p, b"new").map_err(|e| e.to_string())).unwrap();
         assert_eq!(std::fs::read(&ro).unwrap(), b"new");
 

@@ -5,6 +5,7 @@
 //! A may be an integer factor k smaller than B in both axes (a cheaper render of the same view): its blocks
 //! are then N/k pixels wide, so each block covers the same part of the picture in both images.
 
+use crate::lab::LabError;
 use crate::testkit::metrics::RELMSE_EPSILON;
 use std::path::{Path, PathBuf};
 
@@ -72,15 +73,15 @@ pub struct Comparison {
 }
 
 /// Reads an EXR (or render state) as linear RGB.
-pub fn read(path: &Path) -> Result<Image, String> {
+pub fn read(path: &Path) -> Result<Image, LabError> {
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if !matches!(ext.as_deref(), Some("exr") | Some("state")) {
         // PNG holds tonemapped sRGB, not radiance: comparing it would measure the tonemapper.
-        return Err(format!("{}: compare reads linear images (.exr, or a render .state)", path.display()));
+        return Err(LabError::Input(format!("{}: compare reads linear images (.exr, or a render .state)", path.display())));
     }
     let r = crate::lab::reference::read_exr(path)?;
     if r.width == 0 || r.height == 0 {
-        return Err(format!("{}: empty image", path.display()));
+        return Err(LabError::Input(format!("{}: empty image", path.display())));
     }
     Ok(Image { width: r.width, height: r.height, pixels: r.pixels })
 }
@@ -103,21 +104,21 @@ pub fn block_means(img: &Image, block: u32) -> (Vec<[f64; 3]>, u32, u32) {
 }
 
 /// Compares `image` against `reference` with `block`-pixel blocks of the reference.
-pub fn compare(image: &Image, reference: &Image, block: u32) -> Result<Comparison, String> {
+pub fn compare(image: &Image, reference: &Image, block: u32) -> Result<Comparison, LabError> {
     if block == 0 {
-        return Err("--block must be at least 1".into());
+        return Err(LabError::Input("--block must be at least 1".into()));
     }
     // The image may be k times smaller than the reference (k an integer, the same in both axes).
     let k = reference.width / image.width.max(1);
     let same_view = k >= 1 && image.width * k == reference.width && image.height * k == reference.height;
     if !same_view {
-        return Err(format!(
+        return Err(LabError::Input(format!(
             "sizes differ: the image is {}x{}, the reference {}x{} (the image may be smaller by one integer factor in both axes, no other difference)",
             image.width, image.height, reference.width, reference.height
-        ));
+        )));
     }
     if block % k != 0 {
-        return Err(format!("--block {block} is not a multiple of the size factor {k} between the images"));
+        return Err(LabError::Input(format!("--block {block} is not a multiple of the size factor {k} between the images")));
     }
     let (mi, iw, ih) = block_means(image, block / k);
     let (mr, rw, rh) = block_means(reference, block);
@@ -208,7 +209,7 @@ pub fn write_side_by_side(
     reference: &Image,
     panel_width: u32,
     exposure: f32,
-) -> Result<(), String> {
+) -> Result<(), LabError> {
     let panel_width = match panel_width {
         0 => ((20_000.0 * image.width as f64 / image.height as f64).sqrt() as u32).max(1),
         w => w,
@@ -230,22 +231,22 @@ pub fn write_side_by_side(
         }
     }
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-    crate::io::output_file::check(path, true)?.write(|tmp| {
-        let file = std::fs::File::create(tmp).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(crate::io::output_file::check(path, true)?.write(|tmp| {
+        let file = std::fs::File::create(tmp).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
         let encoder =
             PngEncoder::new_with_quality(std::io::BufWriter::new(file), CompressionType::Best, FilterType::Adaptive);
-        out.write_with_encoder(encoder).map_err(|e| format!("{}: {e}", path.display()))
-    })
+        out.write_with_encoder(encoder).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))
+    })?)
 }
 
 /// Runs `mislab compare`: prints the table (or JSON); bad or mismatched input is an error (exit 2).
-pub fn run(args: &CompareArgs) -> Result<u8, String> {
+pub fn run(args: &CompareArgs) -> Result<u8, LabError> {
     let image = read(&args.image)?;
     let reference = read(&args.reference)?;
     let c = compare(&image, &reference, args.block)
-        .map_err(|e| format!("{} vs {}: {e}", args.image.display(), args.reference.display()))?;
+        .map_err(|e| LabError::Input(format!("{} vs {}: {e}", args.image.display(), args.reference.display())))?;
     if args.json {
-        println!("{}", serde_json::to_string(&c).map_err(|e| e.to_string())?);
+        println!("{}", serde_json::to_string(&c).map_err(LabError::from)?);
     } else {
         print!("{}", table(&c));
     }
@@ -328,13 +329,13 @@ mod tests {
         let c = compare(&small, &r, 16).unwrap();
         assert_eq!((c.block_image, c.block_reference, c.blocks), (8, 16, 16));
         assert!(c.block_relmse_all < 1e-12, "{}", c.block_relmse_all);
-        assert!(compare(&small, &r, 15).unwrap_err().contains("multiple"));
+        assert!(compare(&small, &r, 15).unwrap_err().to_string().contains("multiple"));
     }
 
     #[test]
     fn size_mismatches_and_bad_files_are_errors() {
         let e = compare(&constant(30, 20, [1.0; 3]), &constant(64, 40, [1.0; 3]), 16).unwrap_err();
-        assert!(e.contains("sizes differ"), "{e}");
+        assert!(e.to_string().contains("sizes differ"), "{e}");
         // Twice as wide but not twice as high: not the same view.
         assert!(compare(&constant(32, 32, [1.0; 3]), &constant(64, 40, [1.0; 3]), 16).is_err());
         assert!(compare(&constant(64, 40, [1.0; 3]), &constant(32, 20, [1.0; 3]), 16).is_err());
@@ -343,9 +344,9 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let junk = dir.join("junk.exr");
         std::fs::write(&junk, b"not an exr").unwrap();
-        assert!(read(&junk).unwrap_err().contains("junk.exr"));
-        assert!(read(&dir.join("missing.exr")).unwrap_err().contains("missing.exr"));
-        assert!(read(&dir.join("render.png")).unwrap_err().contains("linear"));
+        assert!(read(&junk).unwrap_err().to_string().contains("junk.exr"));
+        assert!(read(&dir.join("missing.exr")).unwrap_err().to_string().contains("missing.exr"));
+        assert!(read(&dir.join("render.png")).unwrap_err().to_string().contains("linear"));
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -11,6 +11,7 @@
 //!   uniform, power, light-tree, RIS and tree-candidate RIS light selection, at equal time (`--time` per panel, default 4 s): which
 //!   light a sample picks decides the noise.
 
+use crate::lab::LabError;
 use crate::api;
 use crate::render::film::Tonemap;
 use crate::render::settings::{Heuristic, LightSampling, LightSelect, Settings, Strategy};
@@ -58,7 +59,7 @@ struct Panel {
 }
 
 /// The scene, the grid (columns) and the panels of a figure.
-fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>), String> {
+fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>), LabError> {
     let with = |strategy: Strategy| Settings { strategy, ..base.clone() };
     match which {
         "veach" => Ok((
@@ -107,13 +108,13 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
             })
             .collect(),
         )),
-        "samplers" => Err("figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into()),
-        other => Err(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", "))),
+        "samplers" => Err(LabError::Input("figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into())),
+        other => Err(LabError::Input(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", ")))),
     }
 }
 
 /// Renders the figure `args.which` and writes it to `args.output` (PNG).
-pub fn run(args: &FigureArgs) -> Result<(), String> {
+pub fn run(args: &FigureArgs) -> Result<(), LabError> {
     if args.which == "samplers" {
         // One column per sampler, four rows (two point sets, two spectra), each about a panel in size.
         let options = match args.spp {
@@ -134,22 +135,22 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
     }
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("png") {
-        return Err(format!("{}: figures are written as PNG (use a .png name)", args.output.display()));
+        return Err(LabError::Input(format!("{}: figures are written as PNG (use a .png name)", args.output.display())));
     }
     let spp = args.spp.unwrap_or(64);
     if spp == 0 {
-        return Err("--spp must be at least 1".into());
+        return Err(LabError::Input("--spp must be at least 1".into()));
     }
     let time = args.time.or((args.which == "many-lights").then_some(4.0));
     if let Some(t) = time {
         if !(t.is_finite() && t > 0.0 && t <= 3600.0) {
-            return Err(format!("--time {t} must be a number of seconds in (0, 3600]"));
+            return Err(LabError::Input(format!("--time {t} must be a number of seconds in (0, 3600]")));
         }
     }
     let base = Settings { width: args.width, height: args.height, seed: args.seed, ..Settings::default() };
     let (scene_name, columns, panels) = layout(&args.which, &base)?;
     base.validate()?;
-    let lab = api::Lab::open().map_err(|e| format!("no usable GPU adapter: {e}"))?;
+    let lab = api::Lab::open().map_err(|e| LabError::Input(format!("no usable GPU adapter: {e}")))?;
     let scene = api::SceneHandle::named(scene_name)?;
     let mut images = Vec::new();
     for p in &panels {
@@ -199,7 +200,7 @@ pub fn run(args: &FigureArgs) -> Result<(), String> {
 
 /// Writes a PNG through a temporary file and a rename (no truncated figure after an interruption); a figure
 /// whose every pixel is grey (both built-in figures) is stored as 8-bit greyscale, a third of the size.
-fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String> {
+fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), LabError> {
     let grey = img.pixels().all(|p| p.0[0] == p.0[1] && p.0[1] == p.0[2]);
     let write = |tmp: &std::path::Path| {
         let result = if grey {
@@ -208,10 +209,10 @@ fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String>
         } else {
             img.save_with_format(tmp, image::ImageFormat::Png)
         };
-        result.map_err(|e| e.to_string())
+        result.map_err(LabError::from)
     };
     crate::io::output_file::replace_atomically(path, write)
-        .map_err(|e| format!("{}: could not write the figure: {e}", path.display()))
+        .map_err(|e| LabError::Input(format!("{}: could not write the figure: {e}", path.display())))
 }
 
 /// Draws `text` (upper-cased; characters without a glyph become blanks) at (x, y) in white on a darkened box,
@@ -323,8 +324,8 @@ mod tests {
     #[test]
     fn unknown_figures_are_errors() {
         let base = Settings::default();
-        assert!(layout("nope", &base).unwrap_err().contains("expected one of"));
-        assert!(layout("samplers", &base).unwrap_err().contains("not rendered in panels"));
+        assert!(layout("nope", &base).unwrap_err().to_string().contains("expected one of"));
+        assert!(layout("samplers", &base).unwrap_err().to_string().contains("not rendered in panels"));
         assert_eq!(layout("veach", &base).unwrap().2.len(), 4);
         assert_eq!(layout("area-vs-cosine", &base).unwrap().2.len(), 3);
     }

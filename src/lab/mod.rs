@@ -2,7 +2,9 @@
 //! and the stress cases.
 
 pub mod bench;
+pub use error::LabError;
 pub mod compare;
+pub mod error;
 pub mod figure;
 pub mod reference;
 pub mod sampler_figure;

@@ -3,6 +3,7 @@
 //! (custom attributes); and reading such references back for `mislab bench`.
 
 pub use crate::api::header_attributes;
+use crate::lab::LabError;
 use crate::api::{self, Budget, RenderStats};
 use crate::gpu::GpuContext;
 pub use crate::io::exr_image::ReferenceImage;
@@ -94,7 +95,7 @@ pub fn render_reference(
     settings: &Settings,
     budget: Budget,
     dispatch_spp: u32,
-) -> Result<(Film, RenderStats), String> {
+) -> Result<(Film, RenderStats), LabError> {
     let lab = api::Lab::on(ctx);
     let handle = api::SceneHandle::from_scene(SceneSpec::named(&scene.name), scene.clone());
     let mut job = api::Job::of(settings.clone(), budget)?;
@@ -105,17 +106,17 @@ pub fn render_reference(
 }
 
 /// Writes `film` as linear float EXR with `attributes` (see `header_attributes`) as text attributes.
-pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), String> {
-    crate::io::exr_image::write(path, film.pixels(), attributes)
+pub fn write_exr(path: &Path, film: &Film, attributes: &[(String, String)]) -> Result<(), LabError> {
+    Ok(crate::io::exr_image::write(path, film.pixels(), attributes)?)
 }
 
 /// Reads a reference: a linear image (EXR from mislab or elsewhere), or a render state (`mislab merge`'s merged
 /// state, or a whole render's), with the attributes `write_exr` records where present.
-pub fn read_exr(path: &Path) -> Result<ReferenceImage, String> {
+pub fn read_exr(path: &Path) -> Result<ReferenceImage, LabError> {
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("state")) {
-        return crate::state::RenderState::read(path).map(|s| s.reference_image());
+        return Ok(crate::state::RenderState::read(path).map(|s| s.reference_image())?);
     }
-    crate::io::exr_image::read(path)
+    Ok(crate::io::exr_image::read(path)?)
 }
 
 /// The image size from --width/--height and the scene's Film size: a flag given wins; with neither given the
@@ -131,18 +132,18 @@ pub fn film_size(width: Option<u32>, height: Option<u32>, scene: Option<[u32; 2]
 }
 
 /// Runs `mislab reference`; returns the exit code (0, or 130 when interrupted after writing what it had).
-pub fn run(args: &ReferenceArgs) -> Result<u8, String> {
+pub fn run(args: &ReferenceArgs) -> Result<u8, LabError> {
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("exr") {
-        return Err(format!("{}: a reference is written as .exr", args.output.display()));
+        return Err(LabError::Input(format!("{}: a reference is written as .exr", args.output.display())));
     }
     // Before any work: an unwritable output would otherwise be found after the render.
     let target = crate::io::output_file::check(&args.output, args.force)?;
     if args.spp.is_none() && args.time.is_none() {
-        return Err("give --spp N or --time SECONDS".into());
+        return Err(LabError::Input("give --spp N or --time SECONDS".into()));
     }
     // The scene first: a bad file is reported without waiting for a device, and its Film size is the default.
-    let scene = args.scene.load()?;
+    let scene = args.scene.load(crate::gpu::chosen_adapter_storage_limit())?;
     let [width, height] = film_size(args.width, args.height, scene.film_size);
     let scene = Scene { film_size: None, ..scene };
     let base = Settings {

@@ -4,6 +4,7 @@
 //! centre, relative to white noise) — the lecture's Halton/Hammersley and blue-noise slides. Computed with the
 //! CPU twins of the WGSL samplers (src/render/samplers.rs), which tests/samplers.rs checks against the device.
 
+use crate::lab::LabError;
 use crate::lab::bench::plot::{self, Figure};
 use crate::render::samplers::{self, SamplerParams, DIMS_CAMERA};
 use crate::render::settings::SamplerKind;
@@ -172,9 +173,9 @@ impl Default for Options {
 
 impl Options {
     /// `--spp N`: N points per panel and spectra at 1 and N spp (N ≤ 1024: the spectra are computed on the CPU).
-    pub fn with_spp(spp: u32, seed: u32) -> Result<Options, String> {
+    pub fn with_spp(spp: u32, seed: u32) -> Result<Options, LabError> {
         if !(1..=1024).contains(&spp) {
-            return Err(format!("--spp {spp}: figure samplers shows 1 to 1024 samples per pixel"));
+            return Err(LabError::Input(format!("--spp {spp}: figure samplers shows 1 to 1024 samples per pixel")));
         }
         let spectrum_spp = if spp == 1 { vec![1] } else { vec![1, spp] };
         Ok(Options { points: spp, spectrum_spp, seed })
@@ -201,8 +202,8 @@ fn point_color(i: usize) -> RGBColor {
 }
 
 impl Figure for SamplerFigure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), LabError> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| LabError::Plot(e.to_string());
         root.fill(&WHITE).map_err(err)?;
         let titled = root
             .titled(
@@ -280,18 +281,18 @@ impl Figure for SamplerFigure {
 }
 
 /// Renders the published figure to `output` (.png or .svg) at `width`×`height` pixels.
-pub fn run(output: &Path, width: u32, height: u32) -> Result<(), String> {
+pub fn run(output: &Path, width: u32, height: u32) -> Result<(), LabError> {
     run_with(output, width, height, &Options::default())
 }
 
 /// Renders the figure with `options` to `output` (.png or .svg) at `width`×`height` pixels.
-pub fn run_with(output: &Path, width: u32, height: u32, options: &Options) -> Result<(), String> {
+pub fn run_with(output: &Path, width: u32, height: u32, options: &Options) -> Result<(), LabError> {
     let ext = output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     if ext != "png" && ext != "svg" {
-        return Err(format!("{}: the figure is written as .png or .svg", output.display()));
+        return Err(LabError::Input(format!("{}: the figure is written as .png or .svg", output.display())));
     }
     if !(200..=16384).contains(&width) || !(200..=16384).contains(&height) {
-        return Err(format!("figure size {width}x{height} is out of range (200..=16384 per side)"));
+        return Err(LabError::Input(format!("figure size {width}x{height} is out of range (200..=16384 per side)")));
     }
     // SVG gets coarser spectra: one rectangle element per cell.
     let cells = if ext == "svg" { 32 } else { SPECTRUM_SIZE };

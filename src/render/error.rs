@@ -1,7 +1,10 @@
 //! Why the renderer could not do what it was asked: the render layer's error type. Every variant's message
 //! stands alone (the CLI prints it after the scene's name and exits 2).
 
+use std::path::PathBuf;
+
 use crate::gpu::GpuError;
+use crate::io::output_file::OutputError;
 
 /// An error from the renderer (`render::Renderer`).
 #[derive(Debug, thiserror::Error)]
@@ -9,9 +12,9 @@ pub enum RenderError {
     /// Waiting on or reading back from the device failed.
     #[error(transparent)]
     Gpu(#[from] GpuError),
-    /// The settings are out of range (`Settings::validate`'s message).
-    #[error("{0}")]
-    Settings(String),
+    /// The settings are out of range.
+    #[error(transparent)]
+    Settings(#[from] InvalidSettings),
     /// A render pipeline could not be built (shader composition or validation).
     #[error("{0}")]
     Pipeline(String),
@@ -24,14 +27,19 @@ pub enum RenderError {
     /// A saved state of another film size was handed to `restore`.
     #[error("a state of {got} pixels cannot continue a {want}-pixel film")]
     StateSize { got: usize, want: usize },
+    /// The image could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// An output file name whose extension names no format mislab writes.
+    #[error("{}: unknown output format '.{ext}' (use .png or .exr)", .path.display())]
+    OutputFormat { path: PathBuf, ext: String },
     /// `configure` was asked to change the film size.
     #[error("the film size cannot change on an existing renderer")]
     FilmSizeChange,
 }
 
-/// Layers above that still speak in messages take a render error as its message.
-impl From<RenderError> for String {
-    fn from(e: RenderError) -> String {
-        e.to_string()
-    }
-}
+/// Settings out of range, or that do not go together (`Settings::validate`, `samplers::check_spp`): the message
+/// names the flag as the command line spells it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct InvalidSettings(pub String);

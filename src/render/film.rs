@@ -2,6 +2,7 @@
 //! PNG (tonemapped, sRGB) or EXR (linear float32 RGB, raw radiance).
 
 use crate::gpu::types::GpuAccum;
+use crate::render::RenderError;
 use std::path::Path;
 
 /// The image as accumulated: mean radiance, per-channel sum of squared deviations, sample counts.
@@ -121,7 +122,7 @@ impl Film {
 
     /// Writes PNG (tonemapped) or EXR (linear) by the extension of `path`, replacing what is there (see
     /// `output_file`: through a temporary file and a rename; symlinks are written through).
-    pub fn save(&self, path: &Path, exposure: f32, op: Tonemap) -> Result<(), String> {
+    pub fn save(&self, path: &Path, exposure: f32, op: Tonemap) -> Result<(), RenderError> {
         self.save_to(&crate::io::output_file::check(path, true)?, exposure, op, &[])
     }
 
@@ -133,20 +134,20 @@ impl Film {
         exposure: f32,
         op: Tonemap,
         attributes: &[(String, String)],
-    ) -> Result<(), String> {
+    ) -> Result<(), RenderError> {
         let path = &target.given;
         let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
         match ext.as_str() {
-            "png" => target.write(|tmp| write_png(tmp, &self.to_rgb8(exposure, op), attributes)),
-            "exr" => target.write(|tmp| crate::io::exr_image::encode(tmp, self.pixels(), attributes)),
-            _ => Err(format!("{}: unknown output format '.{ext}' (use .png or .exr)", path.display())),
+            "png" => Ok(target.write(|tmp| write_png(tmp, &self.to_rgb8(exposure, op), attributes))?),
+            "exr" => Ok(target.write(|tmp| crate::io::exr_image::encode(tmp, self.pixels(), attributes))?),
+            _ => Err(RenderError::OutputFormat { path: path.clone(), ext }),
         }
     }
 }
 
 /// An 8-bit sRGB PNG with an sRGB chunk and one tEXt chunk per attribute.
-fn write_png(path: &Path, img: &image::RgbImage, attributes: &[(String, String)]) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+fn write_png(path: &Path, img: &image::RgbImage, attributes: &[(String, String)]) -> Result<(), png::EncodingError> {
+    let file = std::fs::File::create(path)?;
     let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), img.width(), img.height());
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
@@ -154,9 +155,9 @@ fn write_png(path: &Path, img: &image::RgbImage, attributes: &[(String, String)]
     for (k, v) in attributes {
         // tEXt is Latin-1: keep what fits.
         let v: String = v.chars().map(|c| if (c as u32) < 256 { c } else { '?' }).collect();
-        encoder.add_text_chunk(k.clone(), v).map_err(|e| e.to_string())?;
+        encoder.add_text_chunk(k.clone(), v)?;
     }
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(img.as_raw()).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(img.as_raw())?;
+    writer.finish()
 }

@@ -6,7 +6,7 @@ use crate::gpu::types::*;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
 use crate::render::env_guide;
-pub use crate::render::error::RenderError;
+pub use crate::render::error::{InvalidSettings, RenderError};
 use crate::render::features::{Features, PipelineKey};
 use crate::render::film::Film;
 use crate::render::gpu_scene::GpuScene;

@@ -6,6 +6,7 @@
 //! Every sampler is stateless: (pixel, sample index, dimension, seed) → u ∈ [0, 1). Dimensions are allocated
 //! as `shaders/samplers.wgsl` documents (4 for the camera, then 12 per path vertex, in blocks of 4).
 
+use crate::render::error::InvalidSettings;
 use crate::render::settings::SamplerKind;
 use crate::render::void_and_cluster::void_and_cluster;
 use std::sync::OnceLock;
@@ -454,17 +455,17 @@ pub fn stratified_fits(n: u32) -> bool {
 /// samplers take any spp; stratified rounds to the nearest count whose strata form an nx × ny grid with
 /// ny ≤ nx ≤ 2·ny (ties round up); Hammersley takes any count up to `MAX_SAMPLER_SPP`. When the result differs
 /// from `spp`, print `spp_message(kind, spp, used)`. Set the result as the renderer's `sampler_spp`.
-pub fn check_spp(kind: SamplerKind, spp: u32) -> Result<u32, String> {
+pub fn check_spp(kind: SamplerKind, spp: u32) -> Result<u32, InvalidSettings> {
     if spp == 0 {
-        return Err("--spp must be at least 1".into());
+        return Err(InvalidSettings("--spp must be at least 1".into()));
     }
     if !is_fixed_count(kind) {
         return Ok(spp);
     }
     if spp > MAX_SAMPLER_SPP {
-        return Err(format!(
+        return Err(InvalidSettings(format!(
             "--sampler {kind} builds its points for a fixed count, at most {MAX_SAMPLER_SPP}; {spp} is too many (use sobol or halton for more)"
-        ));
+        )));
     }
     if kind == SamplerKind::Stratified && !stratified_fits(spp) {
         let up = (spp..=MAX_SAMPLER_SPP).find(|&n| stratified_fits(n)).unwrap_or(MAX_SAMPLER_SPP);

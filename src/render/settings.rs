@@ -1,6 +1,7 @@
 //! Settings: one plain struct shared by the CLI flags, the viewer panel and benchmark rows.
 //! `Settings` decide *which* techniques run; scene features decide *which code exists*.
 
+use crate::render::error::InvalidSettings;
 use serde::{Deserialize, Serialize};
 
 /// Default bounce count from which Russian roulette decides whether a path continues (issue 3: "after depth 3").
@@ -291,40 +292,40 @@ impl Settings {
     }
 
     /// Checks values that the type system does not: sizes, counts, β.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidSettings> {
         if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 {
-            return Err(format!("image size {}x{} is out of range (1..=16384 per side)", self.width, self.height));
+            return Err(InvalidSettings(format!("image size {}x{} is out of range (1..=16384 per side)", self.width, self.height)));
         }
         if !(self.power_beta.is_finite() && self.power_beta > 0.0 && self.power_beta <= 16.0) {
-            return Err(format!("--power-beta {} is out of range (0, 16]", self.power_beta));
+            return Err(InvalidSettings(format!("--power-beta {} is out of range (0, 16]", self.power_beta)));
         }
         if self.light_samples > 64 || self.bsdf_samples > 64 || self.light_samples + self.bsdf_samples == 0 {
-            return Err("--light-samples and --bsdf-samples must be in 0..=64 and not both 0".into());
+            return Err(InvalidSettings("--light-samples and --bsdf-samples must be in 0..=64 and not both 0".into()));
         }
         if self.first_hit_light_split == 0 || self.light_samples * self.first_hit_light_split > 64 {
-            return Err(format!(
+            return Err(InvalidSettings(format!(
                 "--first-hit-light-split {} is out of range (1 to 64 / --light-samples)",
                 self.first_hit_light_split
-            ));
+            )));
         }
         if self.ris_candidates == 0 || self.ris_candidates > 64 {
-            return Err(format!("--ris-candidates {} is out of range (1..=64)", self.ris_candidates));
+            return Err(InvalidSettings(format!("--ris-candidates {} is out of range (1..=64)", self.ris_candidates)));
         }
         if self.rr_depth == 0 {
-            return Err("--rr-depth must be at least 1".into());
+            return Err(InvalidSettings("--rr-depth must be at least 1".into()));
         }
         if !(self.exposure.is_finite() && self.exposure.abs() <= crate::io::cli_values::MAX_EXPOSURE) {
-            return Err(format!("exposure {} is out of range (-64..=64 stops)", self.exposure));
+            return Err(InvalidSettings(format!("exposure {} is out of range (-64..=64 stops)", self.exposure)));
         }
         let radius = self.filter_radius();
         if !(radius.is_finite() && (0.05..=16.0).contains(&radius)) {
-            return Err(format!("--filter-radius {radius} is out of range (0.05 to 16 pixels)"));
+            return Err(InvalidSettings(format!("--filter-radius {radius} is out of range (0.05 to 16 pixels)")));
         }
         if !(self.filter_sigma.is_finite() && (0.05..=16.0).contains(&self.filter_sigma)) {
-            return Err(format!("--filter-sigma {} is out of range (0.05 to 16 pixels)", self.filter_sigma));
+            return Err(InvalidSettings(format!("--filter-sigma {} is out of range (0.05 to 16 pixels)", self.filter_sigma)));
         }
         if self.max_depth == 0 || self.max_depth > 256 {
-            return Err(format!("--max-depth {} is out of range (1..=256)", self.max_depth));
+            return Err(InvalidSettings(format!("--max-depth {} is out of range (1..=256)", self.max_depth)));
         }
         Ok(())
     }

@@ -31,8 +31,8 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
         }
     };
     // A regular file only (a FIFO would block, /dev/zero never ends), and within the documented size limit.
-    let (file, len) = crate::io::input_file::open_regular(path).map_err(|m| match m.as_str() {
-        "no such file" => err("environment map not found".into()),
+    let (file, len) = crate::io::input_file::open_regular(path).map_err(|m| match m {
+        crate::io::input_file::InputError::NotFound => err("environment map not found".into()),
         _ => err(format!("environment map {m}")),
     })?;
     let limit = crate::io::input_file::MAX_ENVMAP_BYTES;

@@ -20,7 +20,7 @@ pub mod spec;
 pub mod tga;
 pub mod toml;
 
-pub use spec::SceneSpec;
+pub use spec::{LoadError, SceneSpec};
 
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
@@ -620,7 +620,7 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         return Err(SceneError::new(path, format!("no such file, and not a built-in scene (built-ins: {names})")));
     }
     // Anything but a regular file (a FIFO would block, /dev/zero never ends) is refused before a loader opens it.
-    crate::io::input_file::open_regular(path).map_err(|m| SceneError::new(path, m))?;
+    crate::io::input_file::open_regular(path).map_err(|m| SceneError::new(path, m.to_string()))?;
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     if ext.is_empty() {
         return Err(SceneError::new(

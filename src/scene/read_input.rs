@@ -11,7 +11,10 @@ use std::path::{Path, PathBuf};
 /// `scene.pbrt: line 12`) is added to the error message.
 pub fn read_bytes(path: &Path, referenced_by: &str) -> Result<Vec<u8>, SceneError> {
     crate::io::input_file::read_bounded(path, MAX_IMPORT_BYTES).map_err(|e| {
-        let e = if e == "no such file" { "file not found".to_string() } else { e };
+        let e = match e {
+            crate::io::input_file::InputError::NotFound => "file not found".to_string(),
+            e => e.to_string(),
+        };
         SceneError::new(path, format!("{e}{}", by(referenced_by)))
     })
 }

@@ -1,9 +1,23 @@
 //! The scene as the command line names it — a file or built-in name, a glTF scene index, an environment map that
 //! replaces the scene's own — and the one way every command (render, view, bench, reference, info) loads it.
 
-use super::{envmap, load, Environment, LoadOptions, Scene};
+use super::{envmap, load, Environment, LoadOptions, Scene, SceneError};
 use std::path::PathBuf;
 use std::sync::Arc;
+
+/// Why the scene the command line names could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    /// The file, a file it references, or the environment map (the message names it, and the line).
+    #[error(transparent)]
+    File(#[from] SceneError),
+    /// An override flag out of range (`--env-scale`, `--env-rotation`).
+    #[error("{0}")]
+    Flag(String),
+    /// Nothing to render: no geometry, no lights, no environment.
+    #[error("{scene}: the scene is empty: no geometry, no lights and no environment")]
+    Empty { scene: String },
+}
 
 /// The scene and its environment override, as on the command line.
 #[derive(clap::Args, Clone, Debug, PartialEq)]
@@ -50,24 +64,27 @@ impl SceneSpec {
     }
 
     /// Loads the scene and applies the environment override; prints the loader's warnings once. A scene with
-    /// nothing in it (no geometry, no lights, no environment) is an error, not a black image.
-    pub fn load(&self) -> Result<Scene, String> {
+    /// nothing in it (no geometry, no lights, no environment) is an error, not a black image. With the device's
+    /// storage-binding limit, textures it cannot hold are refused before they are decoded.
+    pub fn load(&self, storage_binding_limit: Option<u64>) -> Result<Scene, LoadError> {
         if !(self.env_scale.is_finite() && self.env_scale >= 0.0 && self.env_scale <= 1e30) {
-            return Err(format!("--env-scale {} must be a finite number in [0, 1e30]", self.env_scale));
+            return Err(LoadError::Flag(format!("--env-scale {} must be a finite number in [0, 1e30]", self.env_scale)));
         }
         if !self.env_rotation.is_finite() {
-            return Err(format!("--env-rotation {} must be a finite number of degrees", self.env_rotation));
+            return Err(LoadError::Flag(format!(
+                "--env-rotation {} must be a finite number of degrees",
+                self.env_rotation
+            )));
         }
         let options = LoadOptions {
             gltf_scene: self.gltf_scene,
             allow_outside_paths: self.allow_outside_paths,
-            // Refuse textures the device cannot hold before decoding them (the limit costs no device): two
-            // bindings' worth (render/gpu_scene.rs split_texels).
-            max_texel_bytes: crate::gpu::chosen_adapter_storage_limit().map(|l| 2 * l),
+            // Two bindings' worth (render/gpu_scene.rs split_texels).
+            max_texel_bytes: storage_binding_limit.map(|l| 2 * l),
         };
-        let mut s = load(&self.scene, &options).map_err(|e| e.to_string())?;
+        let mut s = load(&self.scene, &options)?;
         if let Some(env) = &self.env {
-            let (map, warnings) = envmap::load_envmap(env).map_err(|e| e.to_string())?;
+            let (map, warnings) = envmap::load_envmap(env)?;
             s.warnings.extend(warnings);
             s.environment = Environment::Map {
                 map: Arc::new(map),
@@ -83,7 +100,7 @@ impl SceneSpec {
             eprintln!("warning: {}: {w}", self.scene);
         }
         if geometry == 0 && !s.has_lights() {
-            return Err(format!("{}: the scene is empty: no geometry, no lights and no environment", self.scene));
+            return Err(LoadError::Empty { scene: self.scene.clone() });
         }
         Ok(s)
     }

@@ -2,7 +2,7 @@
 //! LeVeque's parallel update of mean and second moment), refusing missing, duplicate, overlapping, incomplete or
 //! foreign parts by name; and `mislab merge --status DIR`: how far a split render is.
 
-use super::{RenderState, StateHeader};
+use super::{RenderState, StateError, StateHeader};
 use crate::gpu::types::GpuAccum;
 use crate::render::film::Tonemap;
 use std::path::{Path, PathBuf};
@@ -45,12 +45,12 @@ fn range_text(r: (u32, u32)) -> String {
 
 /// Checks that `parts` are complete parts of one render that together hold each of its sample indices exactly
 /// once; returns them sorted by first sample index.
-pub fn check_parts(mut parts: Vec<Part>) -> Result<Vec<Part>, String> {
-    let first = parts.first().ok_or("no state files to merge")?;
+pub fn check_parts(mut parts: Vec<Part>) -> Result<Vec<Part>, StateError> {
+    let first = parts.first().ok_or_else(|| StateError::Parts("no state files to merge".into()))?;
     let (name0, h0) = (first.path.display().to_string(), first.state.header.clone());
     for p in &parts[1..] {
         if let Some(d) = p.state.header.differences(&h0) {
-            return Err(format!("{}: a foreign part (not of the render {name0} is of): {d}", p.path.display()));
+            return Err(StateError::Mismatch(format!("{}: a foreign part (not of the render {name0} is of): {d}", p.path.display())));
         }
     }
     for (i, a) in parts.iter().enumerate() {
@@ -60,20 +60,20 @@ pub fn check_parts(mut parts: Vec<Part>) -> Result<Vec<Part>, String> {
                 _ => a.path == b.path,
             };
             if same {
-                return Err(format!("{}: given twice", a.path.display()));
+                return Err(StateError::Mismatch(format!("{}: given twice", a.path.display())));
             }
         }
     }
     for p in &parts {
         let h = &p.state.header;
         if !h.is_complete() {
-            return Err(format!(
+            return Err(StateError::Mismatch(format!(
                 "{}: an incomplete part: it holds samples {} of {} (finish it with `mislab render … --resume {}`)",
                 p.path.display(),
                 range_text((h.range.0, h.next)),
                 range_text(h.range),
                 p.path.display()
-            ));
+            )));
         }
     }
     parts.sort_by_key(|p| p.state.header.range);
@@ -85,13 +85,13 @@ pub fn check_parts(mut parts: Vec<Part>) -> Result<Vec<Part>, String> {
             let prev = &parts[i - 1];
             let pr = prev.state.header.range;
             let what = if pr == r { "duplicate parts" } else { "overlapping parts" };
-            return Err(format!(
+            return Err(StateError::Mismatch(format!(
                 "{what}: {} (samples {}) and {} (samples {})",
                 prev.path.display(),
                 range_text(pr),
                 p.path.display(),
                 range_text(r)
-            ));
+            )));
         }
         if r.0 > covered {
             missing.push((covered, r.0));
@@ -102,12 +102,12 @@ pub fn check_parts(mut parts: Vec<Part>) -> Result<Vec<Part>, String> {
         missing.push((covered, h0.spp_total));
     }
     if !missing.is_empty() {
-        return Err(format!(
+        return Err(StateError::Mismatch(format!(
             "missing parts: samples {} of the {} are in none of the files{}",
             missing.iter().map(|&r| range_text(r)).collect::<Vec<_>>().join(", "),
             h0.spp_total,
             missing_part_names(&missing, h0.part.map(|p| p.1), h0.spp_total)
-        ));
+        )));
     }
     Ok(parts)
 }
@@ -188,14 +188,14 @@ pub fn exr_attributes(h: &StateHeader, parts: usize) -> Vec<(String, String)> {
 }
 
 /// Runs `mislab merge`; returns the exit code.
-pub fn run(args: &MergeArgs) -> Result<u8, String> {
+pub fn run(args: &MergeArgs) -> Result<u8, StateError> {
     if let Some(dir) = &args.status {
         return status(dir);
     }
-    let output = args.output.clone().ok_or("give -o OUT.exr (or .png)")?;
+    let output = args.output.clone().ok_or_else(|| StateError::Flags("give -o OUT.exr (or .png)".into()))?;
     let ext = output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     if ext != "exr" && ext != "png" {
-        return Err(format!("{}: unknown output format (use .exr or .png)", output.display()));
+        return Err(StateError::Flags(format!("{}: unknown output format (use .exr or .png)", output.display())));
     }
     let parts = args
         .parts
@@ -231,15 +231,15 @@ fn pixel_counts(s: &RenderState) -> (u32, u32) {
 
 /// `mislab merge --status DIR`: per render found in DIR, the samples done of the target, each file's sample range,
 /// and the ranges no file holds.
-pub fn status(dir: &Path) -> Result<u8, String> {
-    let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+pub fn status(dir: &Path) -> Result<u8, StateError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| StateError::Parts(format!("{}: {e}", dir.display())))?;
     let mut files: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == "state"))
         .collect();
     files.sort();
     if files.is_empty() {
-        return Err(format!("{}: no .state files", dir.display()));
+        return Err(StateError::Parts(format!("{}: no .state files", dir.display())));
     }
     // Group by render (scene, settings, total).
     let mut groups: Vec<(StateHeader, Vec<Part>)> = Vec::new();

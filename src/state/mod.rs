@@ -8,8 +8,11 @@
 //! `{mean: [f32; 3], count: u32, m2: [f32; 3], nonfinite: u32}` (the WGSL `Accum`), then the FNV-1a 64 hash of
 //! every byte before it (a truncated or corrupted file is refused instead of resumed).
 
+pub mod error;
 pub mod merge;
 pub mod session;
+
+pub use error::StateError;
 
 use crate::gpu::types::GpuAccum;
 use crate::render::film::Film;
@@ -232,8 +235,8 @@ impl RenderState {
     }
 
     /// Parses a state file's bytes; `name` is the file for messages.
-    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<RenderState, String> {
-        let bad = |why: String| format!("{name}: not a usable mislab state file: {why}");
+    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<RenderState, StateError> {
+        let bad = |problem: String| StateError::Invalid { file: name.to_string(), problem };
         if bytes.len() < 16 || &bytes[..8] != MAGIC {
             return Err(bad("it does not start with the mislab state signature 'MISLABST'".into()));
         }
@@ -293,20 +296,20 @@ impl RenderState {
     }
 
     /// Reads a state file.
-    pub fn read(path: &Path) -> Result<RenderState, String> {
+    pub fn read(path: &Path) -> Result<RenderState, StateError> {
+        let read = |source| StateError::Read { path: path.into(), source };
         // A regular file only: a FIFO or a device in its place must not block or never end.
-        let (mut file, _) = crate::io::input_file::open_regular(path)
-            .map_err(|e| format!("{}: cannot read the state file: {e}", path.display()))?;
+        let (mut file, _) = crate::io::input_file::open_regular(path).map_err(read)?;
         let mut bytes = Vec::new();
         std::io::Read::read_to_end(&mut file, &mut bytes)
-            .map_err(|e| format!("{}: cannot read the state file: {e}", path.display()))?;
+            .map_err(|e| read(crate::io::input_file::InputError::Read(e)))?;
         RenderState::from_bytes(&bytes, &path.display().to_string())
     }
 
     /// Writes the state atomically (temporary file, fsync, rename).
-    pub fn write(&self, path: &Path) -> Result<(), String> {
+    pub fn write(&self, path: &Path) -> Result<(), StateError> {
         let bytes = self.to_bytes();
-        crate::io::output_file::replace_atomically(path, |tmp| std::fs::write(tmp, &bytes).map_err(|e| e.to_string()))
-            .map_err(|e| format!("{}: could not write the state file: {e}", path.display()))
+        crate::io::output_file::replace_atomically(path, |tmp| std::fs::write(tmp, &bytes))
+            .map_err(|message| StateError::Write { path: path.into(), message })
     }
 }

@@ -1,11 +1,11 @@
 //! The render command's state flags (`--state`, `--checkpoint-every`, `--resume`, `--part`): which sample
 //! indices this run renders, restoring a saved state into the renderer, and writing checkpoints while it renders.
 
-use super::{RenderState, StateHeader};
+use super::{RenderState, StateError, StateHeader};
 use crate::gpu::types::GpuAccum;
 use crate::gpu::GpuContext;
 use crate::render::settings::Settings;
-use crate::render::Renderer;
+use crate::render::{RenderError, Renderer};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -67,25 +67,25 @@ impl Session {
     /// Checks the flags and reads the state to resume (before any scene or device work, so a bad state file
     /// fails fast). `spp` is the render's --spp, `output` its image (whose name with `.state` is the default
     /// state file; without one, --state or --resume must name the file).
-    pub fn open(args: &StateArgs, spp: Option<u32>, output: Option<&Path>) -> Result<Option<Session>, String> {
+    pub fn open(args: &StateArgs, spp: Option<u32>, output: Option<&Path>) -> Result<Option<Session>, StateError> {
         if !args.active() {
             return Ok(None);
         }
         // The state to resume first: it says the render's sample count and part, and a bad file is reported as such.
         let resumed = args.resume.as_deref().map(RenderState::read).transpose()?;
         if spp.is_none() && resumed.is_none() {
-            return Err("--state, --checkpoint-every and --part need --spp N (the sample range a state holds is fixed by it; --time is not reproducible)".into());
+            return Err(StateError::Flags("--state, --checkpoint-every and --part need --spp N (the sample range a state holds is fixed by it; --time is not reproducible)".into()));
         }
         let every = match args.checkpoint_every {
             None => None,
             Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
-            Some(t) => return Err(format!("--checkpoint-every {t} must be a positive number of seconds")),
+            Some(t) => return Err(StateError::Flags(format!("--checkpoint-every {t} must be a positive number of seconds"))),
         };
         let path = match (args.state.clone().or_else(|| args.resume.clone()), output) {
             (Some(path), _) => path,
             (None, Some(output)) => output.with_extension("state"),
             (None, None) => {
-                return Err("--part and --checkpoint-every need --state FILE (the state file to write)".into())
+                return Err(StateError::Flags("--part and --checkpoint-every need --state FILE (the state file to write)".into()))
             }
         };
         check_state_path(&path, output)?;
@@ -116,16 +116,16 @@ impl Session {
         settings: &Settings,
         spp_total: u32,
         sampler_spp: u32,
-    ) -> Result<(), String> {
+    ) -> Result<(), StateError> {
         let range = match self.part {
             Some((k, n)) => part_range(k, n, spp_total),
             None => (0, spp_total),
         };
         if range.0 == range.1 {
             let (k, n) = self.part.unwrap_or((0, 1));
-            return Err(format!(
+            return Err(StateError::Flags(format!(
                 "--part {k}/{n} of --spp {spp_total} holds no samples (use at most {spp_total} parts)"
-            ));
+            )));
         }
         let header = StateHeader {
             scene: scene.to_string(),
@@ -146,15 +146,15 @@ impl Session {
             Some(state) => {
                 let name = self.resume_name();
                 if let Some(d) = state.header.differences(&header) {
-                    return Err(format!(
+                    return Err(StateError::Mismatch(format!(
                         "{name}: cannot resume: the state is of a different render (saved vs this command): {d}"
-                    ));
+                    )));
                 }
                 if state.header.part != header.part || state.header.range != header.range {
-                    return Err(format!(
+                    return Err(StateError::Mismatch(format!(
                         "{name}: cannot resume: the state holds part {:?} (samples {:?}), this command renders part {:?} (samples {:?})",
                         state.header.part, state.header.range, header.part, header.range
-                    ));
+                    )));
                 }
                 renderer.restore(
                     &state.accum,
@@ -193,9 +193,9 @@ impl Session {
     }
 
     /// Writes the renderer's current state to the state file (atomically).
-    pub fn save(&self, ctx: &GpuContext, renderer: &Renderer, seconds: f64) -> Result<(), String> {
-        let header = self.header.as_ref().ok_or("Session::save before Session::start")?;
-        let film = renderer.film(ctx).map_err(|e| e.to_string())?;
+    pub fn save(&self, ctx: &GpuContext, renderer: &Renderer, seconds: f64) -> Result<(), StateError> {
+        let header = self.header.as_ref().expect("Session::save is called after Session::start");
+        let film = renderer.film(ctx).map_err(RenderError::from)?;
         let header = StateHeader {
             next: renderer.samples(),
             nonfinite_total: renderer.nonfinite_total(),
@@ -209,20 +209,20 @@ impl Session {
 
 /// Refuses a state path that is the output image too (the image written after the state would replace it) or that
 /// is something other than a regular file (a directory, FIFO or device cannot hold a state, and a FIFO would block).
-fn check_state_path(path: &Path, output: Option<&Path>) -> Result<(), String> {
+fn check_state_path(path: &Path, output: Option<&Path>) -> Result<(), StateError> {
     if let Some(output) = output {
         if same_file(path, output) {
-            return Err(format!(
+            return Err(StateError::Path(format!(
                 "{}: the state file and the output image are the same file (the image would overwrite the state); \
                  name the state with --state",
                 path.display()
-            ));
+            )));
         }
     }
     match std::fs::metadata(path) {
         Ok(m) if !m.is_file() => {
             let kind = if m.is_dir() { "a directory" } else { "not a regular file (a FIFO, socket or device)" };
-            Err(format!("{}: is {kind}; a render state is written to a regular file", path.display()))
+            Err(StateError::Path(format!("{}: is {kind}; a render state is written to a regular file", path.display())))
         }
         _ => Ok(()),
     }

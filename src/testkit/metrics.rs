@@ -15,19 +15,28 @@ pub struct ErrorMetrics {
     pub mae: f64,
 }
 
-fn check(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<(), String> {
+
+/// Why two images cannot be compared.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MetricsError {
+    #[error("the image has {image} pixels, the reference {reference}")]
+    SizeMismatch { image: usize, reference: usize },
+    #[error("empty image")]
+    Empty,
+}
+fn check(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<(), MetricsError> {
     if image.len() != reference.len() {
-        return Err(format!("the image has {} pixels, the reference {}", image.len(), reference.len()));
+        return Err(MetricsError::SizeMismatch { image: image.len(), reference: reference.len() });
     }
     if image.is_empty() {
-        return Err("empty image".into());
+        return Err(MetricsError::Empty);
     }
     Ok(())
 }
 
 /// RMSE, relMSE and MAE of `image` against `reference` (row-major RGB, the same size). Non-finite pixels
 /// make the metrics non-finite (they are errors, not something to skip).
-pub fn compare(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<ErrorMetrics, String> {
+pub fn compare(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<ErrorMetrics, MetricsError> {
     check(image, reference)?;
     let (mut se, mut rel, mut ae) = (0.0f64, 0.0f64, 0.0f64);
     for (x, r) in image.iter().zip(reference) {
@@ -44,22 +53,22 @@ pub fn compare(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<ErrorMetric
 }
 
 /// RMSE of `image` against `reference`.
-pub fn rmse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, String> {
+pub fn rmse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, MetricsError> {
     Ok(compare(image, reference)?.rmse)
 }
 
 /// relMSE = mean over pixels and channels of (x − r)² / (r² + 0.01).
-pub fn relmse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, String> {
+pub fn relmse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, MetricsError> {
     Ok(compare(image, reference)?.relmse)
 }
 
 /// Mean absolute error.
-pub fn mae(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, String> {
+pub fn mae(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, MetricsError> {
     Ok(compare(image, reference)?.mae)
 }
 
 /// relMSE of each pixel (mean over its three channels), for heatmaps.
-pub fn per_pixel_relmse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<Vec<f64>, String> {
+pub fn per_pixel_relmse(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<Vec<f64>, MetricsError> {
     check(image, reference)?;
     Ok(image
         .iter()

@@ -111,7 +111,7 @@ impl Viewer {
     /// Sends side `i`'s settings (after a change in the panel) and starts timing the toggle.
     pub fn apply_settings(&mut self, i: usize) {
         if let Err(e) = self.settings[i].validate() {
-            self.status = e;
+            self.status = e.to_string();
             return;
         }
         let generation_before = self.engine.shared().stats[i].generation;

@@ -2,6 +2,7 @@
 //! image the window shows, plus per-workgroup statistics sums; the false-colour scale's CPU twin for the
 //! legend.
 
+use crate::viewer::ViewerError;
 use crate::gpu::types::GpuAccum;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::film::Tonemap;
@@ -205,7 +206,7 @@ pub struct DisplayOutput {
 
 impl DisplayPass {
     /// Builds the display pipeline for a `width`×`height` film.
-    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<DisplayPass, String> {
+    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<DisplayPass, ViewerError> {
         let device = ctx.device.clone();
         let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
             binding,
@@ -246,7 +247,8 @@ impl DisplayPass {
                     Some(&pipeline_layout),
                 )
             })
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(ViewerError::Input)?;
         let stats_pipeline = crate::render::shaders::compute_pipeline(
             &device,
             None,
@@ -255,7 +257,8 @@ impl DisplayPass {
             "stats_main",
             &[],
             Some(&pipeline_layout),
-        )?;
+        )
+        .map_err(ViewerError::Input)?;
         let workgroups = (width.div_ceil(8), height.div_ceil(8));
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -403,22 +406,22 @@ pub fn upload_reference(ctx: &GpuContext, rgb: &[[f32; 3]]) -> wgpu::Buffer {
 }
 
 /// Reads a reference EXR (or any float image `image` decodes) and checks it matches the film size.
-pub fn load_reference(path: &std::path::Path, width: u32, height: u32) -> Result<Vec<[f32; 3]>, String> {
+pub fn load_reference(path: &std::path::Path, width: u32, height: u32) -> Result<Vec<[f32; 3]>, ViewerError> {
     let img = image::ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
-        .map_err(|e| format!("{}: {e}", path.display()))?
+        .map_err(|e| ViewerError::Input(format!("{}: {e}", path.display())))?
         .decode()
-        .map_err(|e| format!("{}: could not read the reference: {e}", path.display()))?
+        .map_err(|e| ViewerError::Input(format!("{}: could not read the reference: {e}", path.display())))?
         .to_rgb32f();
     if img.width() != width || img.height() != height {
-        return Err(format!(
+        return Err(ViewerError::Input(format!(
             "{}: the reference is {}x{} but the film is {}x{} (render it with the same --width/--height)",
             path.display(),
             img.width(),
             img.height(),
             width,
             height
-        ));
+        )));
     }
     Ok(img.pixels().map(|p| p.0).collect())
 }

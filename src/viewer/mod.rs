@@ -4,6 +4,8 @@
 //! `engine`), in bounded-time bands, so the window stays responsive on a software rasterizer.
 
 pub mod app;
+pub mod error;
+pub use error::ViewerError;
 pub mod camera;
 pub mod display;
 pub mod engine;
@@ -94,12 +96,12 @@ impl Default for ViewArgs {
 }
 
 /// Loads the scene (see `SceneSpec::load`).
-pub fn load_scene(args: &ViewArgs) -> Result<Scene, String> {
-    args.scene.load()
+pub fn load_scene(args: &ViewArgs) -> Result<Scene, ViewerError> {
+    Ok(args.scene.load(crate::gpu::chosen_adapter_storage_limit())?)
 }
 
 /// The engine configuration and the panel's starting state for `args`.
-pub fn config(args: &ViewArgs, scene: Scene) -> Result<(EngineConfig, [Settings; 2], DisplayOptions), String> {
+pub fn config(args: &ViewArgs, scene: Scene) -> Result<(EngineConfig, [Settings; 2], DisplayOptions), ViewerError> {
     let a = Settings {
         width: args.width,
         height: args.height,
@@ -125,10 +127,10 @@ pub fn config(args: &ViewArgs, scene: Scene) -> Result<(EngineConfig, [Settings;
 }
 
 /// A viewer (UI state + engine thread) on a render device of its own, as the window and the tests use it.
-pub fn start(args: &ViewArgs, repaint: Arc<dyn Fn() + Send + Sync>) -> Result<Viewer, String> {
+pub fn start(args: &ViewArgs, repaint: Arc<dyn Fn() + Send + Sync>) -> Result<Viewer, ViewerError> {
     let scene = load_scene(args)?;
     let (config, settings, display) = config(args, scene)?;
-    let ctx = GpuContext::new().map_err(|e| e.to_string())?;
+    let ctx = GpuContext::new().map_err(ViewerError::from)?;
     let compare = config.compare;
     let engine = engine::spawn(ctx, config, repaint);
     if let Some(r) = &args.reference {
@@ -330,11 +332,11 @@ impl eframe::App for App {
 /// Opens the viewer window and runs it until it is closed (or, with --screenshot, until the
 /// screenshot is written). Errors: the scene or device could not be opened, the window could not be
 /// created, or the renderer stopped (device lost for good).
-pub fn run(args: ViewArgs) -> Result<(), String> {
+pub fn run(args: ViewArgs) -> Result<(), ViewerError> {
     if let Some(p) = &args.screenshot {
         let ext = p.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
         if ext.as_deref() != Some("png") {
-            return Err(format!("{}: --screenshot writes PNG (use a .png name)", p.display()));
+            return Err(ViewerError::Input(format!("{}: --screenshot writes PNG (use a .png name)", p.display())));
         }
     }
     // Fail before opening a window when the scene or the device is missing.
@@ -363,7 +365,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     };
     let outcome: Outcome = Arc::new(Mutex::new(None));
     let outcome2 = outcome.clone();
-    let startup_error: Arc<Mutex<Option<String>>> = Arc::new(Mutex::new(None));
+    let startup_error: Arc<Mutex<Option<ViewerError>>> = Arc::new(Mutex::new(None));
     let startup_error2 = startup_error.clone();
     let result = eframe::run_native(
         "mislab view",
@@ -373,8 +375,8 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
             let viewer = match start(&args, Arc::new(move || ctx.request_repaint())) {
                 Ok(v) => v,
                 Err(e) => {
-                    *startup_error2.lock().unwrap_or_else(|p| p.into_inner()) = Some(e.clone());
-                    return Err(e.into());
+                    *startup_error2.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+                    return Err("the viewer could not start".into());
                 }
             };
             let shot = args.screenshot.clone().map(|path| Screenshot {
@@ -395,7 +397,7 @@ pub fn run(args: ViewArgs) -> Result<(), String> {
     if let Some(e) = startup_error.lock().unwrap_or_else(|p| p.into_inner()).take() {
         return Err(e);
     }
-    result.map_err(|e| format!("could not open the viewer window: {e}"))?;
+    result.map_err(|e| ViewerError::Input(format!("could not open the viewer window: {e}")))?;
     let outcome = outcome.lock().unwrap_or_else(|p| p.into_inner()).take();
-    outcome.unwrap_or(Ok(()))
+    outcome.unwrap_or(Ok(())).map_err(ViewerError::Input)
 }

@@ -1,5 +1,6 @@
 //! The `mislab bench` flags and the groups they describe (comma lists, a TOML file or a built-in suite).
 
+use crate::lab::LabError;
 use super::*;
 
 /// `mislab bench` flags.
@@ -83,9 +84,9 @@ pub struct BenchArgs {
 }
 impl BenchArgs {
     /// The groups these flags describe.
-    pub fn groups(&self) -> Result<Vec<BenchGroup>, String> {
+    pub fn groups(&self) -> Result<Vec<BenchGroup>, LabError> {
         if self.suite.is_some() && self.config.is_some() {
-            return Err("--suite and --config exclude each other".into());
+            return Err(LabError::Input("--suite and --config exclude each other".into()));
         }
         let ladder = if self.spp.is_empty() { None } else { Some(self.spp.clone()) };
         let mut groups = match (self.suite, &self.config) {
@@ -102,10 +103,10 @@ impl BenchArgs {
                 )
             }
             (None, Some(path)) => {
-                let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-                let file: BenchFile = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+                let text = std::fs::read_to_string(path).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
+                let file: BenchFile = toml::from_str(&text).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
                 if file.group.is_empty() {
-                    return Err(format!("{}: no [[group]] tables", path.display()));
+                    return Err(LabError::Input(format!("{}: no [[group]] tables", path.display())));
                 }
                 // Relative paths in the file are relative to the file.
                 let dir = path.parent().unwrap_or(Path::new("."));

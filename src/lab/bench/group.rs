@@ -1,6 +1,7 @@
 //! A benchmark group: one scene, film, mode, ladder and seeds, and the settings lists whose cross product are its
 //! configurations.
 
+use crate::lab::LabError;
 use super::*;
 
 /// One comparison: a scene, film, mode, ladder and seeds, and the settings lists whose cross product are its
@@ -209,22 +210,22 @@ impl BenchGroup {
         }
     }
 
-    pub(super) fn check(&self) -> Result<(), String> {
+    pub(super) fn check(&self) -> Result<(), LabError> {
         if self.seeds == 0 {
-            return Err(format!("group '{}': seeds must be at least 1", self.name));
+            return Err(LabError::Input(format!("group '{}': seeds must be at least 1", self.name)));
         }
         if self.time.is_none() && (self.spp.is_empty() || self.spp.contains(&0)) {
-            return Err(format!("group '{}': the spp ladder must be non-empty and positive", self.name));
+            return Err(LabError::Input(format!("group '{}': the spp ladder must be non-empty and positive", self.name)));
         }
         if let Some(t) = self.time {
             if !(t.is_finite() && t > 0.0) {
-                return Err(format!("group '{}': time {t} must be a positive number of seconds", self.name));
+                return Err(LabError::Input(format!("group '{}': time {t} must be a positive number of seconds", self.name)));
             }
         }
         for &ris_candidates in &self.ris_candidates {
             let s = Settings { ris_candidates, ..Settings::default() };
-            s.validate().map_err(|e| format!("group '{}': {e}", self.name))?;
+            s.validate().map_err(|e| LabError::Input(format!("group '{}': {e}", self.name)))?;
         }
-        Settings { width: self.width, height: self.height, max_depth: self.max_depth, ..Settings::default() }.validate()
+        Ok(Settings { width: self.width, height: self.height, max_depth: self.max_depth, ..Settings::default() }.validate()?)
     }
 }

@@ -19,6 +19,7 @@ mod ticks;
 
 pub use args::BenchArgs;
 pub use group::{BenchFile, BenchGroup};
+use crate::lab::LabError;
 use output::write_outputs;
 use results::summarize;
 pub use results::{to_csv, BenchRow, ConfigSummary, CSV_COLUMNS};
@@ -53,16 +54,16 @@ pub enum Suite {
 }
 
 /// Runs `mislab bench`.
-pub fn run(args: &BenchArgs) -> Result<(), String> {
+pub fn run(args: &BenchArgs) -> Result<(), LabError> {
     let groups = args.groups()?;
-    let ctx = GpuContext::new().map_err(|e| e.to_string())?;
+    let ctx = GpuContext::new().map_err(LabError::from)?;
     eprintln!(
         "adapter: {} ({:?}); GPU time from {}",
         ctx.info.name,
         ctx.info.device_type,
         if ctx.timestamps { "timestamp queries" } else { "wall clock (no TIMESTAMP_QUERY)" }
     );
-    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out).map_err(|e| LabError::Input(format!("{}: {e}", args.out.display())))?;
     let refs = args.out.join("refs");
     let mut results = vec![];
     for g in &groups {

@@ -1,12 +1,13 @@
 //! Writing a run's results: results.csv, results.json, summary.md and the plots.
 
+use crate::lab::LabError;
 use super::*;
 
-pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult]) -> Result<(), String> {
+pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult]) -> Result<(), LabError> {
     let rows: Vec<BenchRow> = results.iter().flat_map(|r| r.rows.clone()).collect();
-    let write = |name: &str, text: &str| -> Result<(), String> {
+    let write = |name: &str, text: &str| -> Result<(), LabError> {
         let p = out.join(name);
-        std::fs::write(&p, text).map_err(|e| format!("{}: {e}", p.display()))
+        std::fs::write(&p, text).map_err(|e| LabError::Input(format!("{}: {e}", p.display())))
     };
     write("results.csv", &to_csv(&rows))?;
     let summaries: Vec<(String, Vec<ConfigSummary>)> = results
@@ -30,7 +31,7 @@ pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult
         "groups": results.iter().zip(&summaries).map(|(r, (_, s))| serde_json::json!({ "group": group_json(r), "reference": r.reference, "reference_spp": r.reference_spp, "summary": s })).collect::<Vec<_>>(),
         "rows": rows,
     });
-    write("results.json", &serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?)?;
+    write("results.json", &serde_json::to_string_pretty(&json).map_err(LabError::from)?)?;
     let mut md = format!("# Benchmark results\n\nDevice: {} ({:?}). Times are GPU time from timestamp queries; pipeline compilation and warm-up are excluded (listed separately). relMSE = mean over pixels and channels of (x − r)² / (r² + 0.01); efficiency = 1 / (relMSE · seconds).\n", ctx.info.name, ctx.info.device_type);
     for (res, (name, sums)) in results.iter().zip(&summaries) {
         let base = slug(name);

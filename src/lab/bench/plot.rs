@@ -1,6 +1,7 @@
 //! Plots (plotters): PNG through an in-memory RGB bitmap encoded by `image`, and SVG. Text uses egui's Hack
 //! font, registered with plotters' ab_glyph text backend (no system fonts needed).
 
+use crate::lab::LabError;
 use super::ticks;
 use super::ConfigSummary;
 use plotters::coord::combinators::{BindKeyPoints, LogCoord, WithKeyPoints};
@@ -23,37 +24,37 @@ pub fn register_font() {
 /// Something drawn on any backend.
 pub trait Figure {
     /// Draws on `root`.
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), LabError>;
 }
 
 /// Writes `figure` as `base.png` and `base.svg` in `dir`.
-pub fn save(dir: &Path, base: &str, size: (u32, u32), figure: &impl Figure) -> Result<(), String> {
+pub fn save(dir: &Path, base: &str, size: (u32, u32), figure: &impl Figure) -> Result<(), LabError> {
     save_png(&dir.join(format!("{base}.png")), size, figure)?;
     save_svg(&dir.join(format!("{base}.svg")), size, figure)
 }
 
 /// Writes `figure` as PNG.
-pub fn save_png(path: &Path, (w, h): (u32, u32), figure: &impl Figure) -> Result<(), String> {
+pub fn save_png(path: &Path, (w, h): (u32, u32), figure: &impl Figure) -> Result<(), LabError> {
     register_font();
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         figure.draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(|e| LabError::Plot(e.to_string()))?;
     }
-    image::save_buffer(path, &buf, w, h, image::ExtendedColorType::Rgb8).map_err(|e| format!("{}: {e}", path.display()))
+    image::save_buffer(path, &buf, w, h, image::ExtendedColorType::Rgb8).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))
 }
 
 /// Writes `figure` as SVG.
-pub fn save_svg(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), String> {
+pub fn save_svg(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), LabError> {
     register_font();
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
         figure.draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(|e| LabError::Plot(e.to_string()))?;
     }
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+    std::fs::write(path, text).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))
 }
 
 /// Line colours (Okabe–Ito, distinguishable for colour-blind readers).
@@ -109,8 +110,8 @@ pub struct ErrorPlot {
 }
 
 impl Figure for ErrorPlot {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), LabError> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| LabError::Plot(e.to_string());
         root.fill(&WHITE).map_err(err)?;
         let pts = self.series.iter().flat_map(|s| s.1.iter()).filter(|p| p.0 > 0.0 && p.2 > 0.0 && p.3.is_finite());
         let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
@@ -166,7 +167,7 @@ impl Figure for ErrorPlot {
 }
 
 /// relMSE against seconds and against spp, one line per configuration.
-pub fn error_plots(dir: &Path, base: &str, title: &str, sums: &[ConfigSummary]) -> Result<(), String> {
+pub fn error_plots(dir: &Path, base: &str, title: &str, sums: &[ConfigSummary]) -> Result<(), LabError> {
     let series = |by_time: bool| -> Vec<(String, Vec<(f64, f64, f64, f64)>)> {
         sums.iter()
             .map(|s| {
@@ -215,8 +216,8 @@ pub struct Heatmaps {
 }
 
 impl Figure for Heatmaps {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), LabError> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| LabError::Plot(e.to_string());
         root.fill(&WHITE).map_err(err)?;
         let (w, h) = root.dim_in_pixel();
         let titled = root.titled(&self.title, ("sans-serif", 18)).map_err(err)?;
@@ -300,7 +301,7 @@ pub fn heatmaps(
     w: u32,
     h: u32,
     maps: &[(String, Vec<f64>)],
-) -> Result<(), String> {
+) -> Result<(), LabError> {
     if maps.is_empty() {
         return Ok(());
     }

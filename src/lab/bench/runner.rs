@@ -1,6 +1,7 @@
 //! Running a group: its reference (given or rendered and cached), then every configuration over the spp ladder and
 //! the seeds, timed per dispatch.
 
+use crate::lab::LabError;
 use super::*;
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -34,20 +35,20 @@ fn group_reference(
     g: &BenchGroup,
     scene: &crate::scene::Scene,
     refs: &Path,
-) -> Result<(Vec<[f32; 3]>, String, Option<u32>), String> {
+) -> Result<(Vec<[f32; 3]>, String, Option<u32>), LabError> {
     // What the header says, not what was asked: a given file's spp is its own.
     let header_spp = |r: &reference::ReferenceImage| r.attributes.get("spp").and_then(|s| s.parse().ok());
     if let Some(path) = &g.reference {
         let r = reference::read_exr(path)?;
         if (r.width, r.height) != (g.width, g.height) {
-            return Err(format!(
+            return Err(LabError::Input(format!(
                 "{}: the reference is {}x{}, the benchmark renders {}x{}",
                 path.display(),
                 r.width,
                 r.height,
                 g.width,
                 g.height
-            ));
+            )));
         }
         let spp = header_spp(&r);
         return Ok((r.pixels, path.display().to_string(), spp));
@@ -89,7 +90,7 @@ fn group_reference(
             }
         }
     }
-    std::fs::create_dir_all(refs).map_err(|e| format!("{}: {e}", refs.display()))?;
+    std::fs::create_dir_all(refs).map_err(|e| LabError::Input(format!("{}: {e}", refs.display())))?;
     eprintln!("reference: rendering {} spp of {} ({}) ...", g.reference_spp, g.scene, g.mode.name());
     let t = Instant::now();
     let (film, stats) = reference::render_reference(
@@ -104,8 +105,8 @@ fn group_reference(
     Ok((film.mean, path.display().to_string(), Some(stats.spp)))
 }
 
-pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResult, String> {
-    let scene = g.scene_spec().load()?;
+pub(super) fn run_group(ctx: &GpuContext, g: &BenchGroup, refs: &Path) -> Result<GroupResult, LabError> {
+    let scene = g.scene_spec().load(crate::gpu::chosen_adapter_storage_limit())?;
     let sized;
     let g = match (g.scene_film_size, scene.film_size) {
         (true, Some([width, height])) => {
@@ -128,18 +129,18 @@ pub fn run_configurations(
     g: &BenchGroup,
     scene: &crate::scene::Scene,
     reference: &[[f32; 3]],
-) -> Result<(Vec<BenchRow>, Vec<(String, Vec<f64>)>), String> {
+) -> Result<(Vec<BenchRow>, Vec<(String, Vec<f64>)>), LabError> {
     if reference.len() != (g.width * g.height) as usize {
-        return Err(format!(
+        return Err(LabError::Input(format!(
             "the reference has {} pixels, the benchmark renders {}x{}",
             reference.len(),
             g.width,
             g.height
-        ));
+        )));
     }
     let configs = g.configurations();
     let data = SceneData::build(scene);
-    let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", g.scene))?;
+    let gpu_scene = GpuScene::upload(ctx, data).map_err(|e| LabError::Input(format!("{}: {e}", g.scene)))?;
     let mut renderer: Option<Renderer> = None;
     let mut rows = vec![];
     let mut heatmaps = vec![];
@@ -156,12 +157,12 @@ pub fn run_configurations(
             None => renderer.insert(Renderer::new_unprepared(ctx, &gpu_scene, scene.camera.clone(), settings.clone())?),
         };
         r.prepare()?;
-        r.warm_up(ctx).map_err(|e| e.to_string())?;
+        r.warm_up(ctx).map_err(LabError::from)?;
         // The renderer's own dispatch size (as `mislab render` uses), unless the group fixes one.
         let mut dispatch_spp = if g.dispatch_spp > 0 { g.dispatch_spp } else { r.max_dispatch_spp() };
         let compile_seconds = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        r.render(ctx, 1).map_err(|e| e.to_string())?;
+        r.render(ctx, 1).map_err(LabError::from)?;
         let warmup_seconds = t1.elapsed().as_secs_f64();
         eprintln!("{} / {label}: pipeline ready in {compile_seconds:.2} s, warm-up {warmup_seconds:.2} s", g.name);
         let mut sum_heat: Option<Vec<f64>> = None;
@@ -178,7 +179,7 @@ pub fn run_configurations(
                         eprintln!("  lavapipe's loop budget dropped samples at {spp} spp; retrying with {dispatch_spp} spp per dispatch");
                     }
                     Err(SeedError::Incomplete(spp)) => {
-                        return Err(format!("{label}: pixels miss samples at {spp} spp even with 1 spp per dispatch"))
+                        return Err(LabError::Input(format!("{label}: pixels miss samples at {spp} spp even with 1 spp per dispatch")))
                     }
                     Err(SeedError::Other(e)) => return Err(e),
                 }
@@ -257,18 +258,12 @@ struct Point {
 enum SeedError {
     /// Some pixel holds fewer samples than dispatched (at this spp).
     Incomplete(u32),
-    Other(String),
+    Other(LabError),
 }
 
-impl From<String> for SeedError {
-    fn from(e: String) -> Self {
-        SeedError::Other(e)
-    }
-}
-
-impl From<crate::render::RenderError> for SeedError {
-    fn from(e: crate::render::RenderError) -> Self {
-        SeedError::Other(e.to_string())
+impl<E: Into<LabError>> From<E> for SeedError {
+    fn from(e: E) -> Self {
+        SeedError::Other(e.into())
     }
 }
 
@@ -312,7 +307,7 @@ fn run_seed(
             };
             cumulative
         };
-        let film = r.film(ctx).map_err(|e| e.to_string())?;
+        let film = r.film(ctx).map_err(LabError::from)?;
         if !film.is_complete(spp) {
             return Err(SeedError::Incomplete(spp));
         }

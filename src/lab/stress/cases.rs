@@ -1,6 +1,7 @@
 //! The stress cases: scenes built in code at extreme scales, angles, sizes and radiances, with their analytic
 //! answers where they have one.
 
+use crate::lab::LabError;
 use super::{Case, Check, F32_FLOOR};
 use crate::render::settings::{EnvSampling, LightSampling, Mode, SamplerKind, Settings, Strategy};
 use crate::scene::{self, Camera, Environment, Material, Mesh, PunctualLight, Quad, Scene, Sphere};
@@ -243,13 +244,13 @@ fn furnace_with(material: Material) -> Scene {
 
 /// Writes an equirectangular EXR of `texels` (w×h) to the temp directory and loads it through the same
 /// loader as `--env` (which sanitises it); returns the environment and the loader's warnings.
-fn env_from_texels(name: &str, w: u32, h: u32, texels: &[[f32; 3]]) -> Result<(Environment, Vec<String>), String> {
+fn env_from_texels(name: &str, w: u32, h: u32, texels: &[[f32; 3]]) -> Result<(Environment, Vec<String>), LabError> {
     let dir = std::env::temp_dir().join(format!("mislab-stress-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(|e| LabError::Input(format!("{}: {e}", dir.display())))?;
     let path = dir.join(format!("{name}.exr"));
     let img = image::Rgb32FImage::from_fn(w, h, |x, y| image::Rgb(texels[(y * w + x) as usize]));
-    img.save_with_format(&path, image::ImageFormat::OpenExr).map_err(|e| format!("{}: {e}", path.display()))?;
-    let (map, warnings) = scene::envmap::load_envmap(&path).map_err(|e| e.to_string())?;
+    img.save_with_format(&path, image::ImageFormat::OpenExr).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
+    let (map, warnings) = scene::envmap::load_envmap(&path).map_err(LabError::from)?;
     let _ = std::fs::remove_file(&path);
     Ok((Environment::Map { map: Arc::new(map), scale: 1.0, rotation: 0.0 }, warnings))
 }
@@ -269,7 +270,7 @@ fn emitter_wall(l: f32) -> Scene {
 }
 
 /// Every stress case, in the order they run (twins before the cases that compare with them).
-pub fn cases() -> Result<Vec<Case>, String> {
+pub fn cases() -> Result<Vec<Case>, LabError> {
     let mut out = Vec::new();
     let mis = settings(Strategy::Mis);
     let path = Settings { mode: Mode::Path, max_depth: 4, ..mis.clone() };
@@ -548,9 +549,9 @@ pub fn cases() -> Result<Vec<Case>, String> {
         bad[1000] = [f32::NEG_INFINITY, f32::NAN, -0.0];
         let (env, warnings) = env_from_texels("bad-texels", w, h, &bad)?;
         if warnings.len() != 1 {
-            return Err(format!(
+            return Err(LabError::Input(format!(
                 "a map with NaN/Inf/negative texels should give exactly one warning, got {warnings:?}"
-            ));
+            )));
         }
         let mut sc = builtin("furnace");
         sc.environment = env;

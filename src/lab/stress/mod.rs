@@ -7,6 +7,7 @@ mod cases;
 
 pub use cases::{cases, polygon_irradiance};
 
+use crate::lab::LabError;
 use crate::gpu::GpuContext;
 use crate::render::film::Film;
 use crate::render::settings::Settings;
@@ -81,7 +82,7 @@ pub struct Outcome {
 
 /// Renders every case (on one thread per core; cases with equal pipelines share one build) and checks it. `filter` keeps the cases whose
 /// name contains it (twins are always run). `progress` is called after each case.
-pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Outcome)) -> Result<Vec<Outcome>, String> {
+pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Outcome)) -> Result<Vec<Outcome>, LabError> {
     let all = cases()?;
     let wanted: Vec<&Case> = all
         .iter()
@@ -100,7 +101,7 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
     // list order, as their results arrive, because a `SameAs` case compares with its twin's mean.
     let next = AtomicUsize::new(0);
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(wanted.len().max(1));
-    let (tx, rx) = mpsc::channel::<(usize, Result<Rendered, String>)>();
+    let (tx, rx) = mpsc::channel::<(usize, Result<Rendered, LabError>)>();
     std::thread::scope(|scope| {
         for _ in 0..workers {
             let tx = tx.clone();
@@ -133,7 +134,7 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
             }
         }
         if outcomes.len() < wanted.len() {
-            return Err(format!("the stress suite stopped after {} of {} cases", outcomes.len(), wanted.len()));
+            return Err(LabError::Input(format!("the stress suite stopped after {} of {} cases", outcomes.len(), wanted.len())));
         }
         Ok(outcomes)
     })
@@ -146,18 +147,18 @@ struct Rendered {
     seconds: f64,
 }
 
-fn render_case(ctx: &GpuContext, c: &Case) -> Result<Rendered, String> {
+fn render_case(ctx: &GpuContext, c: &Case) -> Result<Rendered, LabError> {
     let data = SceneData::build(&c.scene);
-    let gs = GpuScene::upload(ctx, data).map_err(|e| format!("{}: {e}", c.name))?;
+    let gs = GpuScene::upload(ctx, data).map_err(|e| LabError::Input(format!("{}: {e}", c.name)))?;
     let mut r = Renderer::new_unprepared(ctx, &gs, c.scene.camera.clone(), c.settings.clone())?;
     // Cases with equal pipelines share one build (the device's `GpuContext::pipelines`).
     r.prepare()?;
-    r.warm_up(ctx).map_err(|e| e.to_string())?;
+    r.warm_up(ctx).map_err(LabError::from)?;
     r.set_dispatch_spp(c.dispatch_spp);
     let t = Instant::now();
-    r.render(ctx, c.spp).map_err(|e| format!("{}: {e}", c.name))?;
+    r.render(ctx, c.spp).map_err(|e| LabError::Input(format!("{}: {e}", c.name)))?;
     let seconds = t.elapsed().as_secs_f64();
-    let film = r.film(ctx).map_err(|e| format!("{}: {e}", c.name))?;
+    let film = r.film(ctx).map_err(|e| LabError::Input(format!("{}: {e}", c.name)))?;
     Ok(Rendered { film, nonfinite: r.nonfinite_total(), seconds })
 }
 

@@ -21,7 +21,7 @@ use material::{material, MaterialDef};
 /// Errors name the file and, where the problem is in the file, its line.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
     let text = crate::io::input_file::read_bounded_text(path, crate::io::input_file::MAX_TOML_BYTES)
-        .map_err(|m| SceneError::new(path, m))?;
+        .map_err(|m| SceneError::new(path, m.to_string()))?;
     let ctx = Ctx { path, text: &text, dir: path.parent().unwrap_or(Path::new("")).to_path_buf() };
     let file: FileDef = ::toml::from_str(&text).map_err(|e| {
         let at = e.span().map(|s| ctx.position(s.start)).unwrap_or_default();
@@ -542,7 +542,10 @@ fn include(
     let path = ctx.resolve(&d.gltf);
     // The same check every input gets (a FIFO, a directory or /dev/zero is named as what it is).
     if let Err(m) = crate::io::input_file::open_regular(&path) {
-        let m = if m == "no such file" { "not found".to_string() } else { m };
+        let m = match m {
+            crate::io::input_file::InputError::NotFound => "not found".to_string(),
+            m => m.to_string(),
+        };
         return Err(e(&format!("glTF file {}: {m}", path.display())));
     }
     // The include's own `scene` (not the command line's --gltf-scene, which is for a top-level glTF file).

@@ -1,6 +1,7 @@
 //! How each [`Command`] from the UI changes the engine: settings, comparison, camera, display options,
 //! scene, environment and reference loading, EXR saving, and the test hook that loses the device.
 
+use crate::viewer::ViewerError;
 use super::display;
 use super::side::SideState;
 use super::{scene_centre, Command, Engine};
@@ -10,7 +11,7 @@ use crate::scene::{self, Environment, LoadOptions, Scene};
 use std::sync::Arc;
 
 impl Engine {
-    pub(super) fn handle(&mut self, c: Command) -> Result<bool, String> {
+    pub(super) fn handle(&mut self, c: Command) -> Result<bool, ViewerError> {
         match c {
             Command::Quit => return Ok(false),
             Command::Settings(side, s) => {
@@ -52,8 +53,8 @@ impl Engine {
                 // still printed, and a panicking load becomes a message instead of stopping the engine (the
                 // swap it replaces left the silent hook installed for good when the load panicked).
                 let loaded = scene::catch_quietly(|| scene::load(&name, &LoadOptions::default()))
-                    .map_err(|panic| format!("loading {name} failed: {panic}"))
-                    .and_then(|r| r.map_err(|e| e.to_string()));
+                    .map_err(|panic| ViewerError::Input(format!("loading {name} failed: {panic}")))
+                    .and_then(|r| r.map_err(|e| ViewerError::Scene(e.into())));
                 match loaded {
                     Ok(sc) => {
                         let warnings = sc.warnings.len();
@@ -107,11 +108,11 @@ impl Engine {
                         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("render");
                         path.with_file_name(format!("{stem}-b.exr"))
                     };
-                    let film = self.sides[i].renderer.film(&self.ctx).map_err(|e| e.to_string())?;
+                    let film = self.sides[i].renderer.film(&self.ctx).map_err(ViewerError::from)?;
                     match film.save(&p, self.options.exposure, self.options.tonemap) {
                         Ok(()) => written.push(p.display().to_string()),
                         Err(e) => {
-                            self.message(e);
+                            self.message(e.to_string());
                             return Ok(true);
                         }
                     }
@@ -123,7 +124,7 @@ impl Engine {
         Ok(true)
     }
 
-    fn set_scene(&mut self, sc: Scene, name: String) -> Result<(), String> {
+    fn set_scene(&mut self, sc: Scene, name: String) -> Result<(), ViewerError> {
         let gs = match GpuScene::upload(&self.ctx, SceneData::build(&sc)) {
             Ok(g) => g,
             Err(e) => {

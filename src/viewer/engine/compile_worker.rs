@@ -2,6 +2,7 @@
 //! second device first, see [`compile_worker`]), and the engine's side of it: which pipelines to ask for,
 //! in what order, taking the built ones in, and choosing the one a side renders with.
 
+use crate::viewer::ViewerError;
 use super::side::SideState;
 use super::{Engine, PipelineState};
 use crate::gpu::{GpuContext, PipelineMemo};
@@ -139,7 +140,7 @@ impl Engine {
         (jobs_tx, done_rx, stop)
     }
 
-    pub(super) fn warm_renderer(ctx: &GpuContext) -> Result<(GpuScene, Renderer), String> {
+    pub(super) fn warm_renderer(ctx: &GpuContext) -> Result<(GpuScene, Renderer), ViewerError> {
         let gs = GpuScene::upload(ctx, SceneData::build(&Scene::default()))?;
         let r = Renderer::new_unprepared(
             ctx,

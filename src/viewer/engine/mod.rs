@@ -12,6 +12,7 @@
 //! (device loss and recreation), `commands` (how each command changes the engine); this file holds the
 //! tuning constants, the engine's state and its loop.
 
+use crate::viewer::ViewerError;
 use super::display::{self, DisplayPass, ImageStats};
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
@@ -130,10 +131,10 @@ impl Engine {
         config: EngineConfig,
         shared: Arc<Mutex<Shared>>,
         repaint: Arc<dyn Fn() + Send + Sync>,
-    ) -> Result<Engine, String> {
+    ) -> Result<Engine, ViewerError> {
         let (w, h) = (config.settings[0].width, config.settings[0].height);
         let gs = GpuScene::upload(&ctx, SceneData::build(&config.scene))
-            .map_err(|e| format!("{}: {e}", config.scene_name))?;
+            .map_err(|e| ViewerError::Input(format!("{}: {e}", config.scene_name)))?;
         let camera = config.scene.camera.clone();
         let mut sides = Vec::new();
         for s in &config.settings {
@@ -239,7 +240,7 @@ impl Engine {
                         self.worker_stop.store(true, Ordering::SeqCst);
                         return;
                     }
-                    Err(e) => self.message(e),
+                    Err(e) => self.message(e.to_string()),
                 }
                 next = rx.try_recv().ok();
             }
@@ -261,7 +262,7 @@ impl Engine {
                                     self.worker_stop.store(true, Ordering::SeqCst);
                                     return;
                                 }
-                                Err(e) => self.message(e),
+                                Err(e) => self.message(e.to_string()),
                             }
                         }
                     }

@@ -281,7 +281,7 @@ fn engine_main(
     let mut engine = match Engine::new(ctx, config, shared.clone(), repaint.clone()) {
         Ok(e) => e,
         Err(e) => {
-            shared.lock().unwrap_or_else(|p| p.into_inner()).fatal = Some(e);
+            shared.lock().unwrap_or_else(|p| p.into_inner()).fatal = Some(e.to_string());
             repaint();
             return;
         }

@@ -1,6 +1,7 @@
 //! Device loss and GPU errors: the callbacks that report them, and recreating the device and everything
 //! on it (scene, sides, display pass, compile worker, timer) so the render restarts instead of stopping.
 
+use crate::viewer::ViewerError;
 use super::display::DisplayPass;
 use super::side::SideState;
 use super::Engine;
@@ -40,8 +41,8 @@ impl Engine {
             return;
         }
         self.message(format!("GPU error ({why}): recreating the device…"));
-        let attempt = (|| -> Result<(), String> {
-            let ctx = GpuContext::new().map_err(|e| e.to_string())?;
+        let attempt = (|| -> Result<(), ViewerError> {
+            let ctx = GpuContext::new()?;
             let gs = GpuScene::upload(&ctx, SceneData::build(&self.scene))?;
             let mut sides = Vec::new();
             for s in &self.settings {

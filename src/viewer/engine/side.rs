@@ -1,6 +1,7 @@
 //! One side's render state (the full-resolution and the preview renderer, cost estimates, restarts) and
 //! the band planner that sizes each dispatch to the frame budget.
 
+use crate::viewer::ViewerError;
 use super::{PipelineState, PREVIEW_SCALE};
 use crate::gpu::GpuContext;
 use crate::render::gpu_scene::GpuScene;
@@ -33,7 +34,7 @@ impl SideState {
         gs: &GpuScene,
         camera: Camera,
         settings: Settings,
-    ) -> Result<SideState, String> {
+    ) -> Result<SideState, ViewerError> {
         let renderer = Renderer::new_unprepared(ctx, gs, camera.clone(), settings.clone())?;
         let preview_settings = Settings {
             width: settings.width.div_ceil(PREVIEW_SCALE),
@@ -67,7 +68,7 @@ impl SideState {
         self.restarted_at = Some(Instant::now());
     }
 
-    pub(super) fn set_settings(&mut self, s: Settings) -> Result<(), String> {
+    pub(super) fn set_settings(&mut self, s: Settings) -> Result<(), ViewerError> {
         let (w, h) = (self.renderer.settings().width, self.renderer.settings().height);
         let (pw, ph) = (self.preview.settings().width, self.preview.settings().height);
         self.renderer.configure(Settings { width: w, height: h, ..s.clone() })?;
