@@ -15,10 +15,9 @@ fn every_file_is_embedded_and_nonempty() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let name = entry.unwrap().file_name().into_string().unwrap();
         if name.ends_with(".wgsl") {
-            assert!(
-                mislab::render::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty()),
-                "{name} is not embedded in src/render/shaders.rs"
-            );
+            let embedded = mislab::render::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty())
+                || mislab::render::materials::MATERIALS.iter().any(|e| e.file == name && !e.source.trim().is_empty());
+            assert!(embedded, "{name} is not embedded in src/render/shaders.rs nor a render::materials entry's file");
         }
     }
 }
