@@ -1,25 +1,41 @@
-// bsdf.wgsl — the glTF metallic-roughness BSDF (with KHR_materials_specular's specularFactor) as the
-// technique triple eval / sample / pdf. Everything is in the local shading frame (z = shading normal),
-// wo and wi point away from the surface, and `eval` returns f_r WITHOUT the cosine (the lecture's
-// brdf.eval: the estimator multiplies by dot(w, N)).
+// bsdf.wgsl — the material contract, and the microfacet functions the materials share.
 //
-//   f = (1 − m)·[(1 − F_d)·base/π + F_d·S] + m·F_m·S,   S = D·G2 / (4 cosθo cosθi)   (glTF 2.0 appendix B)
-//   F_d = f0 + (f90 − f0)(1 − |wo·h|)⁵ with f0 = 0.04·specular, f90 = specular;  F_m = base + (1 − base)(1 − |wo·h|)⁵
-//   D: GGX (Trowbridge–Reitz); G2: height-correlated Smith.
-// Lambert is {m = 0, specular = 0}; a GGX conductor with Fresnel 1 is {m = 1, base = 1}.
-// bsdf_eval / bsdf_pdf / bsdf_sample are also the dispatch over material kinds: a kind the scene does not use
-// is compiled out by its HAS_* constant, so metallic-roughness scenes run exactly the code they ran before.
+// Every material kind K (src/render/materials.rs `MATERIALS`: its tag, name and file) is one file,
+// shaders/bsdf_K.wgsl, with its own parameter struct and these functions, in the local shading frame (z = shading
+// normal, wo and wi pointing away from the surface):
+//
+//   K_params(p: BsdfParams) -> KParams             its parameters at the shading point, read from its words p.params*
+//                                                  (the layout its registry entry's `pack` writes), with the textures
+//                                                  it uses applied (p.tex_base, p.tex_mr) and, where it cares, the side
+//                                                  the ray arrived from (p.front)
+//   K_eval(q, wo, wi) -> vec3<f32>                 f (BRDF or BTDF) WITHOUT the cosine (the lecture's brdf.eval: the
+//                                                  estimator multiplies by |wi.z|); 0 for delta lobes
+//   K_pdf(q, wo, wi) -> f32                        the solid-angle density of K_sample producing wi; 0 for delta lobes
+//   K_sample(q, wo, u_lobe, u: vec2) -> BsdfSample a direction, its pdf and f (pdf = 0: failed)
+//   K_is_delta(q) -> bool                          delta lobes only (light sampling cannot contribute)
+//   K_has_delta_lobe(q) -> bool                    a delta lobe beside others (a smooth coat's mirror)
+//
+// A kind whose registry entry says it transmits lets wi lie below the surface. The dispatchers bsdf_eval /
+// bsdf_pdf / bsdf_sample / bsdf_is_delta / bsdf_has_delta_lobe / bsdf_transmits are generated from the registry
+// (src/render/materials.rs `dispatch_wgsl`), one `if (HAS_K && p.bsdf_kind == MATERIAL_K)` line per kind each, so a
+// kind the scene does not use is compiled out; the tags and HAS_* overrides are generated there too.
 
-/// What the BSDF needs at one shading point (textures already applied).
+/// What a material's BSDF needs at one shading point: its kind, its parameter words (the kind's own layout, as
+/// stored in `Material`), the texture values at the point and the side the ray arrived from.
 struct BsdfParams {
-    base_color: vec3<f32>,
-    metallic: f32,
-    alpha: f32,
-    specular: f32,
-    bsdf_kind: u32,          // MATERIAL_* (common.wgsl); the fields above are metallic-roughness's
-    eta: vec3<f32>,          // conductor: RGB η
-    alpha_v: f32,            // conductor: GGX α along the bitangent (alpha: along the tangent)
-    k: vec3<f32>,            // conductor: RGB k
+    bsdf_kind: u32,          // MATERIAL_* (generated from src/render/materials.rs)
+    params0: vec4<f32>,
+    params1: vec4<f32>,
+    params2: vec4<f32>,
+    tex_base: vec3<f32>,     // the base-colour texture at the point; 1 without one
+    has_tex_mr: bool,        // a glTF metallic-roughness texture is bound (tex_mr holds its value)
+    tex_mr: vec4<f32>,
+    front: bool,             // the ray arrived from the side the geometric normal points to
+}
+
+/// The BsdfParams of a kind's words, untextured and seen from the front (probe kernels build them so).
+fn bsdf_params(kind: u32, params0: vec4<f32>, params1: vec4<f32>, params2: vec4<f32>) -> BsdfParams {
+    return BsdfParams(kind, params0, params1, params2, vec3<f32>(1.0), false, vec4<f32>(1.0), true);
 }
 
 /// A sampled direction: wi (local), the pdf of the sampling technique (solid angle), and f (no cosine).
@@ -32,24 +48,7 @@ struct BsdfSample {
     delta: bool,
 }
 
-/// Whether the material is delta lobes only (light sampling cannot contribute: estimators.wgsl skips it).
-fn bsdf_is_delta(p: BsdfParams) -> bool {
-    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_is_smooth(p); }
-    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return max(p.alpha, p.alpha_v) < DELTA_ALPHA; }
-    return false;
-}
-
-/// Whether the material has a delta lobe beside others (a smooth coat's mirror): light sampling still serves the
-/// rest, but the hemisphere techniques (uniform, cosine) cannot reach the lobe.
-fn bsdf_has_delta_lobe(p: BsdfParams) -> bool {
-    return HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE && coated_is_smooth(p);
-}
-
-/// Whether the material transmits (wi below the surface is allowed: two-sided light sampling, |cos|).
-fn bsdf_transmits(p: BsdfParams) -> bool {
-    return (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC)
-        || (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION);
-}
+// ---- isotropic GGX (Trowbridge–Reitz) ----
 
 /// GGX normal distribution D(h), h local. Measure: projected solid angle of microfacet normals.
 fn ggx_d(h: vec3<f32>, alpha: f32) -> f32 {
@@ -99,81 +98,63 @@ fn schlick_weight(c: f32) -> f32 {
     return m2 * m2 * m;
 }
 
-/// Probability of choosing the specular lobe when sampling, from the lobes' approximate albedos at wo.
-fn bsdf_specular_probability(p: BsdfParams, wo: vec3<f32>) -> f32 {
-    if (!HAS_SPECULAR) { return 0.0; }
-    if (!HAS_DIFFUSE) { return 1.0; }
-    let fw = schlick_weight(wo.z);
-    let f_d = 0.04 * p.specular + (p.specular - 0.04 * p.specular) * fw;
-    let f_m = luminance(p.base_color + (vec3<f32>(1.0) - p.base_color) * fw);
-    let w_spec = (1.0 - p.metallic) * f_d + p.metallic * f_m;
-    let w_diff = (1.0 - p.metallic) * (1.0 - f_d) * luminance(p.base_color);
-    if (w_spec <= 0.0) { return 0.0; }
-    if (w_diff <= 0.0) { return 1.0; }
-    return w_spec / (w_spec + w_diff);
+// ---- anisotropic GGX, α_u along the frame's tangent x and α_v along its bitangent y (Heitz 2014, eq. 85) ----
+
+/// Anisotropic GGX D(h). Written as the isotropic ggx_d with the stretched slope, without 1 − cos²θ.
+fn aniso_ggx_d(h: vec3<f32>, au: f32, av: f32) -> f32 {
+    let x = h.x / au;
+    let y = h.y / av;
+    let d = x * x + y * y + h.z * h.z;
+    return 1.0 / (PI * au * av * d * d);
 }
 
-/// f_r(wo, wi) without the cosine. Zero below either hemisphere.
-fn bsdf_eval(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_eval(p, wo, wi); }
-    if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_eval(p, wo, wi); }
-    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_eval(p, wo, wi); }
-    if (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION) {
-        return diffuse_transmission_eval(p, wo, wi);
-    }
-    if (wo.z <= 0.0 || wi.z <= 0.0) { return vec3<f32>(0.0); }
-    let h = normalize(wo + wi);
-    let fw = schlick_weight(dot(wo, h));
-    let f0_d = 0.04 * p.specular;
-    let f_d = f0_d + (p.specular - f0_d) * fw;
-    let f_m = p.base_color + (vec3<f32>(1.0) - p.base_color) * fw;
-    var spec = 0.0;
-    if (HAS_SPECULAR && (p.metallic > 0.0 || f_d > 0.0)) {
-        spec = ggx_d(h, p.alpha) * ggx_g2(wo, wi, p.alpha) / (4.0 * wo.z * wi.z);
-    }
-    let dielectric = (1.0 - f_d) * p.base_color * INV_PI + vec3<f32>(f_d * spec);
-    let metal = f_m * spec;
-    return (1.0 - p.metallic) * dielectric + p.metallic * metal;
+/// Smith Λ for anisotropic GGX: the isotropic Λ with α² tan²θ replaced by (α_u² x² + α_v² y²)/z².
+fn aniso_ggx_lambda(w: vec3<f32>, au: f32, av: f32) -> f32 {
+    let a2t2 = (au * au * w.x * w.x + av * av * w.y * w.y) / max(w.z * w.z, 1e-30);
+    return 0.5 * (sqrt(1.0 + a2t2) - 1.0);
 }
 
-/// pdf (solid angle) of `bsdf_sample` producing wi: the mixture of cosine and visible-normal sampling.
-fn bsdf_pdf(p: BsdfParams, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_pdf(p, wo, wi); }
-    if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_pdf(p, wo, wi); }
-    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_pdf(p, wo, wi); }
-    if (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION) {
-        return diffuse_transmission_pdf(p, wo, wi);
-    }
-    if (wo.z <= 0.0 || wi.z <= 0.0) { return 0.0; }
-    let ps = bsdf_specular_probability(p, wo);
-    var pdf = (1.0 - ps) * square_to_cosine_hemisphere_pdf(wi);
-    if (HAS_SPECULAR && ps > 0.0) { pdf += ps * ggx_reflection_pdf(wo, wi, p.alpha); }
-    return pdf;
+fn aniso_ggx_g1(w: vec3<f32>, au: f32, av: f32) -> f32 { return 1.0 / (1.0 + aniso_ggx_lambda(w, au, av)); }
+
+/// Visible normal for wo (z > 0) of the anisotropic GGX: stretch, sample the isotropic cap, un-stretch.
+fn aniso_ggx_sample_visible_normal(wo: vec3<f32>, au: f32, av: f32, u: vec2<f32>) -> vec3<f32> {
+    let wi_std = normalize(vec3<f32>(wo.x * au, wo.y * av, wo.z));
+    let phi = TWO_PI * u.x;
+    let z = (1.0 - u.y) * (1.0 + wi_std.z) - wi_std.z;
+    let sin_theta = safe_sqrt(1.0 - z * z);
+    let h_std = vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), z) + wi_std;
+    return normalize(vec3<f32>(h_std.x * au, h_std.y * av, max(h_std.z, 0.0)));
 }
 
-/// Samples wi: picks a lobe with u_lobe, then cosine (diffuse) or a reflected visible normal (specular).
-/// pdf = 0 marks a failed sample (below the surface).
-fn bsdf_sample(p: BsdfParams, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
-    if (HAS_CONDUCTOR && p.bsdf_kind == MATERIAL_CONDUCTOR) { return conductor_sample(p, wo, u); }
-    if (HAS_COATED_DIFFUSE && p.bsdf_kind == MATERIAL_COATED_DIFFUSE) { return coated_sample(p, wo, u_lobe, u); }
-    if (HAS_DIELECTRIC && p.bsdf_kind == MATERIAL_DIELECTRIC) { return dielectric_sample(p, wo, u_lobe, u); }
-    if (HAS_DIFFUSE_TRANSMISSION && p.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION) {
-        return diffuse_transmission_sample(p, wo, u_lobe, u);
-    }
-    var s: BsdfSample;
-    s.pdf = 0.0;
-    s.f = vec3<f32>(0.0);
-    s.delta = false;
-    if (wo.z <= 0.0) { return s; }
-    let ps = bsdf_specular_probability(p, wo);
-    if (HAS_SPECULAR && u_lobe < ps) {
-        let h = ggx_sample_visible_normal(wo, p.alpha, u);
-        s.wi = reflect(-wo, h);
-    } else {
-        s.wi = square_to_cosine_hemisphere(u);
-    }
-    if (s.wi.z <= 0.0) { return s; }
-    s.pdf = bsdf_pdf(p, wo, s.wi);
-    s.f = bsdf_eval(p, wo, s.wi);
-    return s;
+// ---- anisotropic Beckmann–Spizzichino (Walter et al. 2007; as Mitsuba 3 evaluates it) ----
+
+/// Anisotropic Beckmann D(h).
+fn beckmann_d(h: vec3<f32>, au: f32, av: f32) -> f32 {
+    if (h.z <= 0.0) { return 0.0; }
+    let c2 = h.z * h.z;
+    let e = (h.x * h.x / (au * au) + h.y * h.y / (av * av)) / c2;
+    return exp(-e) / (PI * au * av * c2 * c2);
+}
+
+/// Smith G1 of the anisotropic Beckmann distribution for direction w and microfacet normal h: Walter et al.
+/// 2007's rational fit in a = 1/(α_w tanθ) (exact to about 0.35 %), 0 where w sees the back of h.
+fn beckmann_g1(w: vec3<f32>, h: vec3<f32>, au: f32, av: f32) -> f32 {
+    if (dot(w, h) * w.z <= 0.0) { return 0.0; }
+    let xy2 = au * au * w.x * w.x + av * av * w.y * w.y;
+    if (xy2 <= 0.0) { return 1.0; }
+    let a = abs(w.z) / sqrt(xy2);
+    if (a >= 1.6) { return 1.0; }
+    return (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a);
+}
+
+/// A microfacet normal drawn from D(h)·cosθh of the anisotropic Beckmann distribution.
+fn beckmann_sample_normal(au: f32, av: f32, u: vec2<f32>) -> vec3<f32> {
+    let phi = atan2(av * sin(TWO_PI * u.y), au * cos(TWO_PI * u.y));
+    let c = cos(phi);
+    let s = sin(phi);
+    let inv_a2 = c * c / (au * au) + s * s / (av * av);
+    let tan2 = -log(max(1.0 - u.x, 1e-30)) / inv_a2;
+    let cos_t = 1.0 / sqrt(1.0 + tan2);
+    let sin_t = safe_sqrt(1.0 - cos_t * cos_t);
+    return vec3<f32>(sin_t * c, sin_t * s, cos_t);
 }

@@ -119,35 +119,28 @@ fn oct_decode(code: u32) -> vec3<f32> {
     return select(n, vec3<f32>(0.0), code == NO_NORMAL);
 }
 
-/// glTF metallic-roughness material (KHR_materials_specular's specularFactor included).
-/// Lambert = {metallic 0, specular 0}; GGX conductor with F = 1 = {metallic 1, base colour = reflectance}.
+/// A material: what every kind shares (emission, textures, its kind) and its kind's parameter words, whose layout
+/// the kind's registry entry writes (src/render/materials.rs `pack_*`) and its shader file reads (`<kind>_params` in
+/// shaders/bsdf_<kind>.wgsl). The MATERIAL_* tags are generated from the registry (src/render/materials.rs).
 /// Texture slots hold an index into `tex_info` or INVALID; uv transforms are 2×3 affine (rows xform_*0, xform_*1).
 struct Material {
-    base_color: vec3<f32>,
-    metallic: f32,
     emission: vec3<f32>,
-    alpha: f32,            // GGX α = roughness², clamped to ALPHA_MIN at load
-    specular: f32,
-    base_tex: u32,
-    mr_tex: u32,
+    bsdf_kind: u32,         // MATERIAL_* tag
+    base_tex: u32,          // the base-colour texture (each kind says what it multiplies)
+    mr_tex: u32,            // glTF's metallic-roughness texture (metallic-roughness reads it)
     emissive_tex: u32,
+    _pad0: u32,
     base_xform0: vec4<f32>, // (a, b, c, texcoord): u' = a·u + b·v + c
     base_xform1: vec4<f32>, // (d, e, f, 0):        v' = d·u + e·v + f
     mr_xform0: vec4<f32>,
     mr_xform1: vec4<f32>,
     em_xform0: vec4<f32>,
     em_xform1: vec4<f32>,
-    eta: vec3<f32>,         // conductor: RGB η (bsdf_conductor.wgsl)
-    bsdf_kind: u32,         // MATERIAL_* tag
-    k: vec3<f32>,           // conductor: RGB k
-    alpha_v: f32,           // conductor: GGX α along the bitangent (alpha: along the tangent)
+    params0: vec4<f32>,     // the kind's parameter words
+    params1: vec4<f32>,
+    params2: vec4<f32>,
 }
 
-const MATERIAL_METALLIC_ROUGHNESS: u32 = 0u;
-const MATERIAL_CONDUCTOR: u32 = 1u;
-const MATERIAL_COATED_DIFFUSE: u32 = 3u;
-const MATERIAL_DIELECTRIC: u32 = 2u;              // eta.x = η, alpha/alpha_v, base_color = tint
-const MATERIAL_DIFFUSE_TRANSMISSION: u32 = 4u;    // base_color = reflectance (× base_tex), k = transmittance
 /// GGX α below which conductors and dielectrics are delta lobes (scene::DELTA_ALPHA).
 const DELTA_ALPHA: f32 = 1e-3;
 
@@ -339,19 +332,12 @@ override HAS_TEXEL_SPLIT: bool = true;
 /// Vertices over two to four bindings (src/render/gpu_scene.rs split_vertices): vertex k past tri_verts' length is
 /// in tri_verts_hi, tri_verts_hi2 or tri_verts_hi3. False: those reads are compiled out.
 override HAS_GEOMETRY_SPLIT: bool = true;
-/// Whether any material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
+/// Whether any metallic-roughness material has a GGX lobe (metallic > 0 or specular > 0); false = Lambert only.
+/// (Each material kind's own HAS_* is generated from src/render/materials.rs.)
 override HAS_SPECULAR: bool = true;
-/// Any MaterialKind::Conductor (bsdf_conductor.wgsl).
-override HAS_CONDUCTOR: bool = true;
-/// Any MaterialKind::CoatedDiffuse (bsdf_coated_diffuse.wgsl).
-override HAS_COATED_DIFFUSE: bool = true;
-/// Any MaterialKind::Dielectric (bsdf_dielectric.wgsl).
-override HAS_DIELECTRIC: bool = true;
-/// Any MaterialKind::DiffuseTransmission (bsdf_diffuse_transmission.wgsl).
-override HAS_DIFFUSE_TRANSMISSION: bool = true;
 /// Any triangle with a cut-out mask (alpha.wgsl); false = no alpha test in traversal.
 override HAS_ALPHA: bool = true;
-/// Whether any material has a diffuse lobe.
+/// Whether any metallic-roughness material has a diffuse lobe.
 override HAS_DIFFUSE: bool = true;
 /// More than one light: false skips light selection entirely.
 override MANY_LIGHTS: bool = true;

@@ -22,11 +22,7 @@ fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32)
     c.x = x;
     c.frame = frame_from_normal(x.ns);
     c.wo = to_local(c.frame, -d);
-    c.brdf = material_bsdf(m, x.uv);
-    // A dielectric's η is inside over outside; a ray arriving from inside (the back face) sees 1/η.
-    if (HAS_DIELECTRIC && c.brdf.bsdf_kind == MATERIAL_DIELECTRIC && !x.front && c.brdf.eta.y == 0.0) {
-        c.brdf.eta.x = 1.0 / c.brdf.eta.x;
-    }
+    c.brdf = material_bsdf(m, x.uv, x.front);
     c.id = id;
     c.bounce = bounce;
     return c;

@@ -156,21 +156,16 @@ fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) ->
     return mix(a, b, w.y);
 }
 
-/// The material's BSDF parameters at `uv`.
-fn material_bsdf(m: Material, uv: vec2<f32>) -> BsdfParams {
-    var p = BsdfParams(m.base_color, m.metallic, m.alpha, m.specular, m.bsdf_kind, m.eta, m.alpha_v, m.k);
+/// The material's BSDF parameters at `uv`, seen from the front or not: its words and the values of its textures (its
+/// kind's `<kind>_params` decides what they multiply).
+fn material_bsdf(m: Material, uv: vec2<f32>, front: bool) -> BsdfParams {
+    var p = BsdfParams(m.bsdf_kind, m.params0, m.params1, m.params2, vec3<f32>(1.0), false, vec4<f32>(1.0), front);
     if (HAS_TEXTURES && m.base_tex != INVALID) {
-        let t = texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
-        p.base_color *= t;
-        // Diffuse transmission with a textured transmittance: metallic = 1 says the base texture tints it too.
-        if (HAS_DIFFUSE_TRANSMISSION && m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION && m.metallic > 0.0) { p.k *= t; }
+        p.tex_base = texture_lookup(m.base_tex, m.base_xform0, m.base_xform1, uv).xyz;
     }
     if (HAS_TEXTURES && m.mr_tex != INVALID) {
-        let mr = texture_lookup(m.mr_tex, m.mr_xform0, m.mr_xform1, uv);
-        // glTF: roughness in G, metallic in B; α = roughness².
-        let rough = sqrt(m.alpha) * mr.y;
-        p.alpha = max(rough * rough, 1e-4);
-        p.metallic *= mr.z;
+        p.has_tex_mr = true;
+        p.tex_mr = texture_lookup(m.mr_tex, m.mr_xform0, m.mr_xform1, uv);
     }
     return p;
 }

@@ -210,7 +210,7 @@ const PROBE: &str = r#"
 struct ProbeIn { wo: vec4<f32>, wi: vec4<f32>, r_eta: vec4<f32>, a: vec4<f32>, u: vec4<f32> }
 struct ProbeOut { f_pdf: vec4<f32>, f_rev: vec4<f32>, sample: vec4<f32>, sample_f: vec4<f32> }
 fn probe_coated(x: ProbeIn) -> ProbeOut {
-    let p = BsdfParams(x.r_eta.xyz, 0.0, x.a.x, x.u.z, MATERIAL_COATED_DIFFUSE, vec3<f32>(x.r_eta.w), x.a.y, vec3<f32>(0.0));
+    let p = bsdf_params(MATERIAL_COATED_DIFFUSE, x.r_eta, vec4<f32>(x.a.x, x.a.y, x.u.z, 0.0), vec4<f32>(0.0));
     var o: ProbeOut;
     o.f_pdf = vec4<f32>(bsdf_eval(p, x.wo.xyz, x.wi.xyz), bsdf_pdf(p, x.wo.xyz, x.wi.xyz));
     o.f_rev = vec4<f32>(bsdf_eval(p, x.wi.xyz, x.wo.xyz), coated_internal_reflectance(x.a.w));
@@ -576,7 +576,7 @@ fn coated_render_has_no_nan() {
     }
     let data = mislab::render::scene_data::SceneData::build(&s);
     let f = mislab::render::features::Features::of(&data);
-    assert!(f.coated_diffuse && !f.conductor, "features: {}", f.describe());
+    assert!(f.has_kind("coated_diffuse") && !f.has_kind("conductor"), "features: {}", f.describe());
     // MIS runs both the light samples (bsdf_eval, bsdf_pdf) and the BSDF samples (bsdf_sample); one pipeline.
     let settings = Settings { strategy: Strategy::Mis, ..common::small(48, 48) };
     let film = common::render(&ctx, &s, &settings, 16);

@@ -10,6 +10,7 @@
 use glam::{DVec3, Vec3};
 use mislab::gpu::types::*;
 use mislab::gpu::GpuContext;
+use mislab::render::materials::tag;
 use mislab::render::settings::{EnvSampling, LightSampling, LightSelect};
 use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::{EnvMap, Environment, Material, Mesh, PunctualLight, Quad, Scene, Sphere};
@@ -91,10 +92,21 @@ fn probe_u(i: u32) -> vec4<f32> {
 
 // a = (α, specular, kind, α_v), b = (base colour, metallic); a conductor's η, k do not change where samples go.
 // A dielectric's η does: p.w (0: 1.5). Diffuse transmission's transmittance k is b.w (its metallic is unused).
+// For conductors, coats and dielectrics "specular" = 1 selects Beckmann. Packed into each kind's words as
+// src/render/materials.rs packs them (the layouts are in the kinds' files).
 fn probe_bsdf() -> BsdfParams {
+    let a = probe_job.a;
+    let b = probe_job.b;
+    let kind = u32(a.z);
     let eta = select(vec3<f32>(1.5), vec3<f32>(probe_job.p.w, 0.0, 0.0), probe_job.p.w > 0.0);
-    let k = select(vec3<f32>(3.0), vec3<f32>(probe_job.b.w), u32(probe_job.a.z) == MATERIAL_DIFFUSE_TRANSMISSION);
-    return BsdfParams(probe_job.b.xyz, probe_job.b.w, probe_job.a.x, probe_job.a.y, u32(probe_job.a.z), eta, probe_job.a.w, k);
+    let none = vec4<f32>(0.0);
+    switch (kind) {
+        case MATERIAL_CONDUCTOR: { return bsdf_params(kind, vec4<f32>(b.xyz, a.x), vec4<f32>(eta, a.w), vec4<f32>(vec3<f32>(3.0), a.y)); }
+        case MATERIAL_COATED_DIFFUSE: { return bsdf_params(kind, vec4<f32>(b.xyz, eta.x), vec4<f32>(a.x, a.w, a.y, 0.0), none); }
+        case MATERIAL_DIELECTRIC: { return bsdf_params(kind, vec4<f32>(b.xyz, eta.x), vec4<f32>(a.x, a.w, select(0.0, 1.0, eta.y != 0.0), a.y), none); }
+        case MATERIAL_DIFFUSE_TRANSMISSION: { return bsdf_params(kind, vec4<f32>(b.xyz, 0.0), vec4<f32>(vec3<f32>(b.w), 0.0), none); }
+        default: { return bsdf_params(kind, b, vec4<f32>(a.x, a.y, 0.0, 0.0), none); }
+    }
 }
 
 /// The light's geometric normal at y (either orientation), as surface_at computes it.
@@ -1299,7 +1311,7 @@ fn dielectric_cases() -> Vec<Case> {
             specular,
             Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
         );
-        c.setup.job.a = [au, specular, MATERIAL_DIELECTRIC as f32, av];
+        c.setup.job.a = [au, specular, tag("dielectric") as f32, av];
         c.setup.job.p[3] = eta;
         v.push(c);
     }
@@ -1328,7 +1340,7 @@ fn diffuse_transmission_cases() -> Vec<Case> {
             0.0,
             Dom::Cap(SphereCap::sphere(DVec3::Z, GRID)),
         );
-        c.setup.job.a = [1.0, 0.0, MATERIAL_DIFFUSE_TRANSMISSION as f32, 1.0];
+        c.setup.job.a = [1.0, 0.0, tag("diffuse_transmission") as f32, 1.0];
         v.push(c);
     }
     v
@@ -1349,7 +1361,7 @@ fn bsdf_reciprocity() {
     let count = 1u32 << 12;
     let mut checked = 0;
     for (kind, eta) in
-        [(MATERIAL_DIELECTRIC, 1.5f32), (MATERIAL_DIELECTRIC, 1.0 / 1.33), (MATERIAL_DIFFUSE_TRANSMISSION, 0.0)]
+        [(tag("dielectric"), 1.5f32), (tag("dielectric"), 1.0 / 1.33), (tag("diffuse_transmission"), 0.0)]
     {
         let wo = DVec3::new(0.5, 0.3, 0.8).normalize();
         let mut s = Setup::new(SceneId::Lights, R_BSDF);
@@ -1371,7 +1383,7 @@ fn bsdf_reciprocity() {
                 "kind {kind}: sample f {f_sample} vs eval {f_fwd}"
             );
             let transmitted = a[2] < 0.0;
-            let ratio = if transmitted && kind == MATERIAL_DIELECTRIC { (eta * eta) as f64 } else { 1.0 };
+            let ratio = if transmitted && kind == tag("dielectric") { (eta * eta) as f64 } else { 1.0 };
             assert!(
                 (f_rev - ratio * f_fwd).abs() <= 2e-3 * f_rev.abs().max(ratio * f_fwd.abs()) + 1e-6,
                 "kind {kind}, η {eta}, wi {a:?}: f(wi, wo) {f_rev} vs {ratio}·f(wo, wi) {}",
@@ -1410,7 +1422,7 @@ fn smooth_dielectric_fresnel() {
             let wo = DVec3::new(t.sin(), 0.0, t.cos());
             let mut s = Setup::new(SceneId::Lights, R_BSDF);
             s.job.p = v4(wo, eta);
-            s.job.a = [0.0, 0.0, MATERIAL_DIELECTRIC as f32, 0.0];
+            s.job.a = [0.0, 0.0, tag("dielectric") as f32, 0.0];
             s.job.b = [1.0, 1.0, 1.0, 0.0];
             let f = fresnel_dielectric_ref(wo.z, eta);
             let out = h.sample(&s, count, 0, 1, 7 + inc as u32);

@@ -15,10 +15,9 @@ fn every_file_is_embedded_and_nonempty() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let name = entry.unwrap().file_name().into_string().unwrap();
         if name.ends_with(".wgsl") {
-            assert!(
-                mislab::render::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty()),
-                "{name} is not embedded in src/render/shaders.rs"
-            );
+            let embedded = mislab::render::shaders::FILES.iter().any(|(n, s)| *n == name && !s.trim().is_empty())
+                || mislab::render::materials::MATERIALS.iter().any(|e| e.file == name && !e.source.trim().is_empty());
+            assert!(embedded, "{name} is not embedded in src/render/shaders.rs nor a render::materials entry's file");
         }
     }
 }
@@ -126,6 +125,115 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
                 "{} names a light kind: adding one would have to touch it too",
                 f.display()
             );
+        }
+    }
+}
+
+/// The material contract (docs/adding-a-material.md): every kind is one entry of `render::materials::MATERIALS` and
+/// one file, `shaders/bsdf_<name>.wgsl`, with its parameter struct and the contract's functions; the generated
+/// dispatchers have one line per kind each; no other shader names a kind's tag or override or reads the kind, and
+/// in Rust only the registry names a tag (the scene's `MaterialKind` is the scene description and its importers').
+#[test]
+fn every_material_kind_is_its_file_and_its_registry_entry() {
+    use mislab::render::materials::{dispatch_wgsl, MATERIALS};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let strip =
+        |text: &str| -> String { text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n") };
+    let count = |hay: &str, needle: &str| hay.matches(needle).count();
+    let ops = ["eval", "pdf", "sample", "is_delta", "has_delta_lobe"];
+    let generated = strip(&dispatch_wgsl());
+    let body = |name: &str| -> String {
+        let start = generated.find(&format!("fn {name}(")).unwrap_or_else(|| panic!("no dispatcher {name}"));
+        let rest = &generated[start + 3..];
+        rest[..rest.find("\nfn ").unwrap_or(rest.len())].to_string()
+    };
+    assert!(MATERIALS.len() >= 5, "material kinds: {}", MATERIALS.len());
+    for e in MATERIALS {
+        let upper = e.name.to_uppercase();
+        assert_eq!(e.file, format!("bsdf_{}.wgsl", e.name), "{}: its file", e.name);
+        assert_eq!(e.tag_const, format!("MATERIAL_{upper}"), "{}: its tag's name", e.name);
+        assert_eq!(e.feature, format!("HAS_{upper}"), "{}: its override's name", e.name);
+        let on_disk = std::fs::read_to_string(dir.join("shaders").join(e.file)).unwrap();
+        assert_eq!(on_disk, e.source, "{}: the entry embeds another file", e.name);
+        let code = strip(e.source);
+        let camel: String = e.name.split('_').map(|w| w[..1].to_uppercase() + &w[1..]).collect();
+        let params = format!("{camel}Params");
+        assert_eq!(count(&code, &format!("struct {params} {{")), 1, "{} must define struct {params}", e.file);
+        let unpack = format!("fn {}_params(p: BsdfParams) -> {params} {{", e.name);
+        assert_eq!(count(&code, &unpack), 1, "{} must define `{unpack}`", e.file);
+        for op in ops {
+            let f = format!("fn {}_{op}(q: {params}", e.name);
+            assert_eq!(count(&code, &f), 1, "{} must define `{f}…`", e.file);
+            let b = body(&format!("bsdf_{op}"));
+            let line = format!(
+                "if ({} && p.bsdf_kind == {}) {{ return {}_{op}({}_params(p)",
+                e.feature, e.tag_const, e.name, e.name
+            );
+            assert_eq!(count(&b, &line), 1, "bsdf_{op} needs one line for {}", e.name);
+        }
+        let transmits = format!("({} && p.bsdf_kind == {})", e.feature, e.tag_const);
+        assert_eq!(count(&body("bsdf_transmits"), &transmits), usize::from(e.transmits), "bsdf_transmits: {}", e.name);
+        // A kind's file names no kind's tag or override and reads no kind: the dispatchers chose it already.
+        for other in MATERIALS {
+            assert_eq!(count(&code, other.tag_const), 0, "{} names {}", e.file, other.tag_const);
+            assert_eq!(count(&code, other.feature), 0, "{} names {}", e.file, other.feature);
+        }
+        assert_eq!(count(&code, ".bsdf_kind"), 0, "{} reads a kind", e.file);
+    }
+    // Each dispatcher reads the kind once per kind.
+    for op in ops {
+        assert_eq!(count(&body(&format!("bsdf_{op}")), ".bsdf_kind"), MATERIALS.len(), "bsdf_{op}");
+    }
+    // Every bsdf_*.wgsl but the shared bsdf.wgsl is a registry entry's file.
+    for entry in std::fs::read_dir(dir.join("shaders")).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        if name.starts_with("bsdf_") {
+            assert!(MATERIALS.iter().any(|e| e.file == name), "{name} is no entry of render::materials::MATERIALS");
+        }
+    }
+    // The other shaders name no kind's tag or override, and only material_bsdf (surface.wgsl) reads the kind, to
+    // copy it into BsdfParams.
+    let mut all = String::new();
+    for (name, text) in mislab::render::shaders::FILES {
+        all += &strip(text);
+        for e in MATERIALS {
+            assert!(!strip(text).contains(e.tag_const), "{name} names {}", e.tag_const);
+            assert!(!strip(text).contains(e.feature), "{name} names {}", e.feature);
+        }
+    }
+    assert_eq!(count(&all, "MATERIAL_"), 0, "a shader names a material tag outside the generated dispatchers");
+    assert_eq!(
+        count(&all, ".bsdf_kind"),
+        1,
+        "something besides material_bsdf and the dispatchers reads a material's kind"
+    );
+    // Rust: the tags, their overrides and the kinds' words are named in render/materials.rs alone; `MaterialKind`
+    // (the scene description) in scene/ (its importers) and the registry's `pack_*`.
+    let mut files = Vec::new();
+    let mut stack = vec![dir.join("src")];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                files.push(p);
+            }
+        }
+    }
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let name = f.strip_prefix(dir.join("src")).unwrap().to_str().unwrap().replace('\\', "/");
+        if name == "render/materials.rs" {
+            continue;
+        }
+        for e in MATERIALS {
+            for word in [e.tag_const, e.feature] {
+                assert!(!text.contains(word), "{name} names {word}: adding a material kind would have to touch it too");
+            }
+        }
+        if text.contains("MaterialKind::") {
+            assert!(name.starts_with("scene/"), "{name} names a MaterialKind: only the scene and its importers may");
         }
     }
 }

@@ -91,42 +91,27 @@ pub struct GpuShadingVertex {
     pub uv: [f32; 2],
 }
 
-/// A material (WGSL `Material`); see the WGSL comment for the meaning of each field.
+/// A material (WGSL `Material`): what every kind shares, its kind's tag (`render::materials::MATERIALS`) and that
+/// kind's parameter words (its own layout: `render::materials::pack`, and `<kind>_params` in its shader file).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuMaterial {
-    pub base_color: [f32; 3],
-    pub metallic: f32,
     pub emission: [f32; 3],
-    pub alpha: f32,
-    pub specular: f32,
+    pub bsdf_kind: u32,
     pub base_tex: u32,
     pub mr_tex: u32,
     pub emissive_tex: u32,
+    pub _pad0: u32,
     pub base_xform0: [f32; 4],
     pub base_xform1: [f32; 4],
     pub mr_xform0: [f32; 4],
     pub mr_xform1: [f32; 4],
     pub em_xform0: [f32; 4],
     pub em_xform1: [f32; 4],
-    /// Conductor: RGB η; `bsdf_kind` is a `MATERIAL_*` tag.
-    pub eta: [f32; 3],
-    pub bsdf_kind: u32,
-    /// Conductor: RGB k; `alpha_v` the second GGX α (`alpha` is the first).
-    pub k: [f32; 3],
-    pub alpha_v: f32,
+    pub params0: [f32; 4],
+    pub params1: [f32; 4],
+    pub params2: [f32; 4],
 }
-
-/// Material kinds (`GpuMaterial::bsdf_kind`), as `scene::MaterialKind`.
-pub const MATERIAL_METALLIC_ROUGHNESS: u32 = 0;
-pub const MATERIAL_CONDUCTOR: u32 = 1;
-pub const MATERIAL_COATED_DIFFUSE: u32 = 3;
-/// `MaterialKind::Dielectric`: eta[0] = η, eta[1] = thin (1/0), alpha/alpha_v, base_color = tint
-/// (shaders/bsdf_dielectric.wgsl).
-pub const MATERIAL_DIELECTRIC: u32 = 2;
-/// `MaterialKind::DiffuseTransmission`: base_color = reflectance (× base_tex), k = transmittance (× base_tex
-/// where metallic = 1).
-pub const MATERIAL_DIFFUSE_TRANSMISSION: u32 = 4;
 
 /// One entry of the light table (WGSL `Light`).
 #[repr(C)]

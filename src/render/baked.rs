@@ -593,6 +593,6 @@ mod tests {
         assert_eq!(4 * words("Quad"), std::mem::size_of::<GpuQuad>());
         assert_eq!(4 * words("TriShading"), std::mem::size_of::<GpuTriShading>());
         assert_eq!(4 * words("ShadingVertex"), std::mem::size_of::<GpuShadingVertex>());
-        assert_eq!(wgsl_members("Material")[3], "f32");
+        assert_eq!(wgsl_members("Material")[1], "u32");
     }
 }

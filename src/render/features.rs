@@ -2,6 +2,7 @@
 //! out everything else. `Settings` decide which techniques run; `Features` decide which code exists.
 
 use crate::gpu::types::*;
+use crate::render::materials;
 use crate::render::scene_data::SceneData;
 use crate::render::settings::Settings;
 
@@ -51,18 +52,12 @@ pub struct Features {
     /// Vertices over two to four bindings (`gpu_scene::split_vertices`): vertex reads past `tri_verts` go to
     /// `tri_verts_hi` and the bindings after it.
     pub geometry_split: bool,
-    /// Any material with a GGX lobe.
+    /// Any metallic-roughness material with a GGX lobe.
     pub specular: bool,
-    /// Any material with a diffuse lobe.
+    /// Any metallic-roughness material with a diffuse lobe.
     pub diffuse: bool,
-    /// Any `MaterialKind::Conductor` (shaders/bsdf_conductor.wgsl).
-    pub conductor: bool,
-    /// Any `MaterialKind::CoatedDiffuse` (shaders/bsdf_coated_diffuse.wgsl).
-    pub coated_diffuse: bool,
-    /// Any `MaterialKind::Dielectric` (shaders/bsdf_dielectric.wgsl).
-    pub dielectric: bool,
-    /// Any `MaterialKind::DiffuseTransmission` (shaders/bsdf_diffuse_transmission.wgsl).
-    pub diffuse_transmission: bool,
+    /// The material kinds the scene uses, one bit per `render::materials::MATERIALS` index (each sets its HAS_*).
+    pub materials: u32,
     /// More than one entry in the light table (light selection needed).
     pub many_lights: bool,
     /// Any triangle with a cut-out mask (shaders/alpha.wgsl): the traversal tests alpha at triangle hits.
@@ -102,10 +97,7 @@ impl Features {
             geometry_split: true,
             specular: true,
             diffuse: true,
-            conductor: true,
-            coated_diffuse: true,
-            dielectric: true,
-            diffuse_transmission: true,
+            materials: materials::all(),
             many_lights: true,
             // Not a code path but the layout every scene is built with (SceneData::build).
             wide_bvh: true,
@@ -120,8 +112,7 @@ impl Features {
 
     /// What `data` needs.
     pub fn of(data: &SceneData) -> Features {
-        // The metallic-roughness materials (other kinds have their own constants).
-        let mr = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS);
+        let (specular, diffuse) = materials::metallic_roughness_lobes(&data.materials);
         let kinds = |k: u32| data.lights.iter().any(|l| l.kind == k);
         let alpha = data.has_alpha_cutouts();
         let env = match (data.env_light.is_some(), data.env_size.0 > 0) {
@@ -144,12 +135,9 @@ impl Features {
             checkerboard: data.tex_info.iter().any(|t| t.tex_kind == TEX_CHECKERBOARD),
             texel_split: data.tex_info.iter().any(|t| t.offset & TEXEL_HI != 0),
             geometry_split: !data.tri_verts_hi.is_empty(),
-            specular: mr.clone().any(|m| m.metallic > 0.0 || m.specular > 0.0),
-            diffuse: mr.clone().any(|m| m.metallic < 1.0 || m.mr_tex != INVALID),
-            conductor: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_CONDUCTOR),
-            coated_diffuse: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_COATED_DIFFUSE),
-            dielectric: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIELECTRIC),
-            diffuse_transmission: data.materials.iter().any(|m| m.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION),
+            specular,
+            diffuse,
+            materials: materials::used(&data.materials),
             many_lights: data.selectable_lights() > 1,
             wide_bvh: !data.wide_nodes.is_empty(),
             alpha,
@@ -169,7 +157,7 @@ impl Features {
     /// The WGSL override constants for these features.
     pub fn constants(&self) -> Vec<(&'static str, f64)> {
         let b = |x: bool| if x { 1.0 } else { 0.0 };
-        vec![
+        let mut c = vec![
             ("HAS_TRIANGLES", b(self.triangles)),
             ("HAS_SPHERES", b(self.spheres)),
             ("HAS_QUADS", b(self.quads)),
@@ -185,10 +173,6 @@ impl Features {
             ("HAS_GEOMETRY_SPLIT", b(self.geometry_split)),
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_DIFFUSE", b(self.diffuse)),
-            ("HAS_CONDUCTOR", b(self.conductor)),
-            ("HAS_COATED_DIFFUSE", b(self.coated_diffuse)),
-            ("HAS_DIELECTRIC", b(self.dielectric)),
-            ("HAS_DIFFUSE_TRANSMISSION", b(self.diffuse_transmission)),
             ("MANY_LIGHTS", b(self.many_lights)),
             ("HAS_ALPHA", b(self.alpha)),
             ("FLAT_SCENE", b(self.flat.is_some())),
@@ -197,7 +181,19 @@ impl Features {
             ("BAKED_ROOT", b(self.baked_root)),
             // Not in the generic pipeline: its compilation is minutes already, and this changes no pixel.
             ("LAMP_SIGHTING", b(self.convex_lamps && self.occluders != GENERIC_OCCLUDERS)),
-        ]
+        ];
+        c.extend(materials::MATERIALS.iter().enumerate().map(|(i, e)| (e.feature, b(self.has_material(i)))));
+        c
+    }
+
+    /// Whether the scene uses the kind at `MATERIALS[index]`.
+    pub fn has_material(&self, index: usize) -> bool {
+        self.materials & 1 << index != 0
+    }
+
+    /// Whether the scene uses the material kind named `name` (`MaterialEntry::name`).
+    pub fn has_kind(&self, name: &str) -> bool {
+        materials::MATERIALS.iter().position(|e| e.name == name).is_some_and(|i| self.has_material(i))
     }
 
     /// Human-readable list of the code paths compiled in (for `mislab info`).
@@ -222,10 +218,9 @@ impl Features {
         on("vertices over several bindings", self.geometry_split);
         on("GGX lobe", self.specular);
         on("diffuse lobe", self.diffuse);
-        on("conductor (complex Fresnel, anisotropic GGX)", self.conductor);
-        on("coated diffuse (GGX dielectric coat over Lambert)", self.coated_diffuse);
-        on("dielectric (Fresnel reflection and refraction)", self.dielectric);
-        on("diffuse transmission", self.diffuse_transmission);
+        for (i, e) in materials::MATERIALS.iter().enumerate() {
+            on(e.describe, self.has_material(i) && !e.describe.is_empty());
+        }
         on("light selection", self.many_lights);
         on("alpha cut-outs", self.alpha);
         on("8-wide compressed BVH", self.wide_bvh && self.flat.is_none());

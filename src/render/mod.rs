@@ -12,6 +12,7 @@ pub mod film;
 pub mod gpu_scene;
 pub mod light_table;
 pub mod lights;
+pub mod materials;
 pub mod pipeline_cache;
 pub mod pixel_filter;
 pub mod reachability;

@@ -2,21 +2,9 @@
 //! are found only by light sampling, and light seen through smooth glass or in a mirror (delta BSDF lobes) or
 //! through a closed dielectric only by direction (BSDF) samples.
 
-use crate::gpu::types::{GpuMaterial, MATERIAL_COATED_DIFFUSE, MATERIAL_CONDUCTOR, MATERIAL_DIELECTRIC};
+use crate::render::materials::{has_delta_lobe, is_delta, refracts};
 use crate::render::scene_data::SceneData;
 use crate::render::settings::{Settings, Strategy};
-use crate::scene::DELTA_ALPHA;
-
-/// Whether the material's BSDF is delta-only (an exact mirror or a smooth dielectric, as the shaders decide).
-pub fn is_delta(m: &GpuMaterial) -> bool {
-    let smooth = m.alpha.max(m.alpha_v) < DELTA_ALPHA;
-    m.bsdf_kind == MATERIAL_DIELECTRIC && (smooth || m.eta[1] != 0.0) || m.bsdf_kind == MATERIAL_CONDUCTOR && smooth
-}
-
-/// Whether the material has a delta lobe beside non-delta ones (a smooth coat's mirror over its diffuse base).
-pub fn has_delta_lobe(m: &GpuMaterial) -> bool {
-    m.bsdf_kind == MATERIAL_COATED_DIFFUSE && m.alpha.max(m.alpha_v) < DELTA_ALPHA
-}
 
 /// The warning, if the strategy in `s` cannot reach some of the scene's light; None if it reaches all of it.
 pub fn unreachable_light_warning(data: &SceneData, s: &Settings) -> Option<String> {
@@ -31,7 +19,7 @@ pub fn unreachable_light_warning(data: &SceneData, s: &Settings) -> Option<Strin
     // Light sampling counts no emission found by direction samples, and a shadow ray cannot pass a dielectric
     // (nor leave along a delta lobe): light through glass, or seen in a mirror, is then missing.
     let delta = data.materials.iter().filter(|m| is_delta(m) || has_delta_lobe(m)).count();
-    let dielectric = data.materials.iter().filter(|m| m.bsdf_kind == MATERIAL_DIELECTRIC).count();
+    let dielectric = data.materials.iter().filter(|m| refracts(m)).count();
     if s.strategy == Strategy::Light && (delta > 0 || dielectric > 0) {
         parts.push(format!(
             "--strategy light cannot reach light through the scene's {dielectric} dielectric material(s) or along its {delta} delta (smooth glass / mirror / smooth coat) material(s): a lamp behind glass, or seen only in a mirror, is missing from this image (BSDF sampling finds it: --strategy bsdf or mis)"

@@ -3,7 +3,8 @@
 
 use crate::render::shaders;
 
-/// WGSL files of the render entry point, in order.
+/// WGSL files of the render entry point, in order. `bsdf_materials.wgsl` is generated from the material registry
+/// (`materials::dispatch_wgsl`): every kind's file and the dispatchers over them.
 pub const RENDER_FILES: &[&str] = &[
     "common.wgsl",
     "geometry_bindings.wgsl",
@@ -18,11 +19,8 @@ pub const RENDER_FILES: &[&str] = &[
     "geometry_loads.wgsl",
     "baked_geometry.wgsl",
     "scene_data.wgsl",
-    "bsdf_conductor.wgsl",
-    "bsdf_coated_diffuse.wgsl",
-    "bsdf_dielectric.wgsl",
-    "bsdf_diffuse_transmission.wgsl",
     "bsdf.wgsl",
+    "bsdf_materials.wgsl",
     "surface.wgsl",
     "alpha.wgsl",
     "lights.wgsl",

@@ -397,93 +397,23 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     let (m0, m1, mt) = xform(&m.metallic_roughness_texture);
     let (e0, e1, et) = xform(&m.emissive_texture);
     let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
-    let kind = material_kind(m);
+    let (bsdf_kind, [params0, params1, params2]) = crate::render::materials::pack(m);
     GpuMaterial {
-        // Kinds that carry their own colour (tint, reflectance) put it in base_color themselves.
-        base_color: if matches!(
-            kind.bsdf_kind,
-            MATERIAL_CONDUCTOR | MATERIAL_DIELECTRIC | MATERIAL_DIFFUSE_TRANSMISSION
-        ) {
-            kind.base_color
-        } else {
-            m.base_color.to_array().map(|c| finite(c, 0.0).max(0.0))
-        },
-        metallic: if kind.bsdf_kind == MATERIAL_DIFFUSE_TRANSMISSION {
-            kind.metallic
-        } else {
-            finite(m.metallic, 0.0).clamp(0.0, 1.0)
-        },
         emission: m.emission.to_array().map(|c| finite(c, 0.0).max(0.0)),
-        alpha: if kind.bsdf_kind == MATERIAL_METALLIC_ROUGHNESS { m.alpha() } else { kind.alpha },
-        specular: if matches!(kind.bsdf_kind, MATERIAL_CONDUCTOR | MATERIAL_DIELECTRIC | MATERIAL_COATED_DIFFUSE) {
-            kind.specular
-        } else {
-            finite(m.specular, 1.0).clamp(0.0, 1.0)
-        },
+        bsdf_kind,
         base_tex: bt,
         mr_tex: mt,
         emissive_tex: et,
+        _pad0: 0,
         base_xform0: b0,
         base_xform1: b1,
         mr_xform0: m0,
         mr_xform1: m1,
         em_xform0: e0,
         em_xform1: e1,
-        ..kind
-    }
-}
-
-/// The kind tag and the kind's own parameters (sanitised: finite, η > 0, k ≥ 0, α ≥ ALPHA_MIN).
-fn material_kind(m: &crate::scene::Material) -> GpuMaterial {
-    use crate::scene::{MaterialKind, ALPHA_MIN};
-    let finite = |v: f32, def: f32| if v.is_finite() { v } else { def };
-    let alpha = |a: f32| finite(a, 1.0).clamp(ALPHA_MIN, 1.0);
-    match &m.kind {
-        MaterialKind::MetallicRoughness => GpuMaterial { bsdf_kind: MATERIAL_METALLIC_ROUGHNESS, ..Default::default() },
-        MaterialKind::Conductor { eta, k, alpha_u, alpha_v, tint, beckmann } => GpuMaterial {
-            bsdf_kind: MATERIAL_CONDUCTOR,
-            // specular (unused by this kind): the microfacet distribution, 0 = GGX, 1 = Beckmann.
-            specular: if *beckmann { 1.0 } else { 0.0 },
-            base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
-            eta: eta.to_array().map(|c| finite(c, 1.0).max(1e-3)),
-            k: k.to_array().map(|c| finite(c, 0.0).max(0.0)),
-            alpha: alpha(*alpha_u),
-            alpha_v: alpha(*alpha_v),
-            ..Default::default()
-        },
-        // Reflectance: base_color / base_tex, as for metallic-roughness. η ≥ 1 + 1e-4 (the model has no
-        // total internal reflection from outside; η = 1 would be no coat at all).
-        // specular (unused by these kinds' parameters): the microfacet distribution, 0 = GGX, 1 = Beckmann.
-        MaterialKind::CoatedDiffuse { eta, alpha_u, alpha_v, beckmann } => GpuMaterial {
-            bsdf_kind: MATERIAL_COATED_DIFFUSE,
-            specular: if *beckmann { 1.0 } else { 0.0 },
-            eta: [finite(*eta, 1.5).clamp(1.0001, 10.0), 1.0, 1.0],
-            alpha: alpha(*alpha_u),
-            alpha_v: alpha(*alpha_v),
-            ..Default::default()
-        },
-        MaterialKind::Dielectric { eta, alpha_u, alpha_v, tint, thin, beckmann } => GpuMaterial {
-            bsdf_kind: MATERIAL_DIELECTRIC,
-            specular: if *beckmann { 1.0 } else { 0.0 },
-            // η = 1 has no interface to refract at; keep it off 1 so the Walter half vector stays defined.
-            // eta[1]: the thin-slab flag.
-            eta: {
-                let e = finite(*eta, 1.5).clamp(1e-3, 1e3);
-                [if (e - 1.0).abs() < 1e-4 { 1.0001 } else { e }, if *thin { 1.0 } else { 0.0 }, 0.0]
-            },
-            alpha: alpha(*alpha_u),
-            alpha_v: alpha(*alpha_v),
-            base_color: tint.to_array().map(|c| finite(c, 1.0).max(0.0)),
-            ..Default::default()
-        },
-        MaterialKind::DiffuseTransmission { reflectance, transmittance, transmittance_textured } => GpuMaterial {
-            bsdf_kind: MATERIAL_DIFFUSE_TRANSMISSION,
-            // metallic (unused by this kind): 1 = the base texture multiplies the transmittance too.
-            metallic: if *transmittance_textured { 1.0 } else { 0.0 },
-            base_color: reflectance.to_array().map(|c| finite(c, 0.0).max(0.0)),
-            k: transmittance.to_array().map(|c| finite(c, 0.0).max(0.0)),
-            ..Default::default()
-        },
+        params0,
+        params1,
+        params2,
     }
 }
 

@@ -3,7 +3,8 @@
 
 use crate::gpu::PipelineStore;
 
-/// Every WGSL file, by name, embedded at compile time.
+/// Every WGSL file but the materials', by name, embedded at compile time (each material kind's file is embedded by
+/// its entry in `crate::render::materials::MATERIALS`).
 pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
     ("bvh.wgsl", include_str!("../../shaders/bvh.wgsl")),
@@ -17,10 +18,6 @@ pub const FILES: &[(&str, &str)] = &[
     ("samplers.wgsl", include_str!("../../shaders/samplers.wgsl")),
     ("warps.wgsl", include_str!("../../shaders/warps.wgsl")),
     ("pixel_filter.wgsl", include_str!("../../shaders/pixel_filter.wgsl")),
-    ("bsdf_conductor.wgsl", include_str!("../../shaders/bsdf_conductor.wgsl")),
-    ("bsdf_coated_diffuse.wgsl", include_str!("../../shaders/bsdf_coated_diffuse.wgsl")),
-    ("bsdf_dielectric.wgsl", include_str!("../../shaders/bsdf_dielectric.wgsl")),
-    ("bsdf_diffuse_transmission.wgsl", include_str!("../../shaders/bsdf_diffuse_transmission.wgsl")),
     ("bsdf.wgsl", include_str!("../../shaders/bsdf.wgsl")),
     ("surface.wgsl", include_str!("../../shaders/surface.wgsl")),
     ("alpha.wgsl", include_str!("../../shaders/alpha.wgsl")),
@@ -35,18 +32,22 @@ pub const FILES: &[(&str, &str)] = &[
     ("display.wgsl", include_str!("../../shaders/display.wgsl")),
 ];
 
-/// Modules generated from Rust tables rather than embedded: the binding declarations (`crate::render::bindings`).
-pub const GENERATED: &[&str] = &["geometry_bindings.wgsl", "shading_bindings.wgsl"];
+/// Modules generated from Rust tables rather than embedded: the binding declarations (`crate::render::bindings`)
+/// and the material kinds with their dispatchers (`crate::render::materials`).
+pub const GENERATED: &[&str] = &["geometry_bindings.wgsl", "shading_bindings.wgsl", "bsdf_materials.wgsl"];
 
 /// The source of one embedded or generated file.
 pub fn file(name: &str) -> std::borrow::Cow<'static, str> {
     match name {
         "geometry_bindings.wgsl" => crate::render::bindings::geometry_wgsl().into(),
         "shading_bindings.wgsl" => crate::render::bindings::shading_wgsl().into(),
+        "bsdf_materials.wgsl" => crate::render::materials::dispatch_wgsl().into(),
         _ => FILES
             .iter()
+            .copied()
+            .chain(crate::render::materials::MATERIALS.iter().map(|e| (e.file, e.source)))
             .find(|(n, _)| *n == name)
-            .map(|(_, s)| (*s).into())
+            .map(|(_, s)| s.into())
             .unwrap_or_else(|| panic!("no embedded shader file named {name}")),
     }
 }
