@@ -32,7 +32,7 @@ fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32)
 
 /// The direction technique a strategy uses at c: uniform, cosine, or the BSDF (also for light / mis). Surfaces
 /// that transmit or have delta lobes always use the BSDF: the hemisphere techniques cannot reach those directions.
-fn direction_technique(c: ShadingCtx) -> u32 {
+fn direction_kind(c: ShadingCtx) -> u32 {
     if (bsdf_transmits(c.brdf) || bsdf_is_delta(c.brdf) || bsdf_has_delta_lobe(c.brdf)) { return STRATEGY_BSDF; }
     if (cfg_strategy() == STRATEGY_UNIFORM || cfg_strategy() == STRATEGY_COSINE) { return cfg_strategy(); }
     return STRATEGY_BSDF;
@@ -53,7 +53,7 @@ fn wrong_side(c: ShadingCtx, w: vec3<f32>, wi: vec3<f32>) -> bool {
 
 /// pdf (solid angle) of the direction technique producing local direction wi.
 fn direction_pdf(c: ShadingCtx, wi: vec3<f32>) -> f32 {
-    switch (direction_technique(c)) {
+    switch (direction_kind(c)) {
         case STRATEGY_UNIFORM: { return square_to_uniform_hemisphere_pdf(wi); }
         case STRATEGY_COSINE: { return square_to_cosine_hemisphere_pdf(wi); }
         default: { return bsdf_pdf(c.brdf, c.wo, wi); }
@@ -68,7 +68,7 @@ fn direction_sample(c: ShadingCtx, j: u32) -> BsdfSample {
     var s: BsdfSample;
     s.f = vec3<f32>(0.0);
     s.delta = false;
-    switch (direction_technique(c)) {
+    switch (direction_kind(c)) {
         case STRATEGY_UNIFORM: {
             s.wi = square_to_uniform_hemisphere(u);
             s.pdf = square_to_uniform_hemisphere_pdf(s.wi);
@@ -275,12 +275,15 @@ fn ris_light_technique(c: ShadingCtx, j: u32) -> LightEstimate {
     return out;
 }
 
-/// What a traced direction found: the emitted radiance arriving along it, the light that emits it (INVALID: none)
-/// and the shading point there (the path's next vertex; unset for a miss).
+/// What a traced direction found: the emitted radiance arriving along it, the light that emits it (INVALID: none),
+/// and whether it hit a surface (`surface`: the path's next vertex) or escaped to the environment. A sighted lamp
+/// (`lamp_in_sight`) is neither.
 struct Found {
     le: vec3<f32>,
     light: u32,
     surface: Surface,
+    at_surface: bool,
+    escaped: bool,
 }
 
 /// What the ray o + t·w found at `hit`: a surface (an area light's eval there) or, for a miss, the environment.
@@ -289,26 +292,28 @@ fn found_emission(o: vec3<f32>, w: vec3<f32>, hit: Hit) -> Found {
     r.le = vec3<f32>(0.0);
     r.light = INVALID;
     if (hit.prim == INVALID) {
+        r.escaped = true;
         r.light = params.env_light;
         if (r.light != INVALID) { r.le = env_radiance(w); }
         return r;
     }
+    r.at_surface = true;
     r.surface = surface_at(hit, o, w);
     r.light = r.surface.light;
     if (r.light != INVALID) { r.le = light_eval(r.light, r.surface, w); }
     return r;
 }
 
-/// What a ray from o along w, traced only for the emission it finds (every direction sample in direct mode, a
-/// path's last), finds; p is the shading point it leaves. Towards a convex lamp's inner sphere it is traced only up
-/// to the lamp's stop box: if nothing is there, it finds the lamp (`lamp_in_sight`).
-fn found_emission_only(o: vec3<f32>, w: vec3<f32>, p: vec3<f32>) -> Found {
-    let sight = lamp_in_sight(o, w, p);
-    let hit = trace_closest(o, w, sight.t_box);
-    if (lamp_sighted(sight, hit)) {
-        return lamp_found(sight);
-    }
-    return found_emission(o, w, hit);
+/// Traces direction sample s from o (counted in `rays_traced`). `emission_only`: traced only for the emission it
+/// finds (every direction sample in direct mode, a path's last): towards a convex lamp's inner sphere it then stops
+/// at the lamp's stop box, and if nothing is hit before it, it finds the lamp (`lamp_in_sight`).
+fn trace_found(o: vec3<f32>, s: DirectionSample, emission_only: bool) -> Found {
+    rays_traced += 1u;
+    var sight = LampSighting(INVALID, vec3<f32>(0.0), F32_MAX);
+    if (emission_only) { sight = lamp_in_sight(o, s.w, s.p); }
+    let hit = trace_closest(o, s.w, sight.t_box);
+    if (lamp_sighted(sight, hit)) { return lamp_found(sight); }
+    return found_emission(o, s.w, hit);
 }
 
 /// Whether a ray traced up to `sight`'s stop box found its lamp: nothing hit before the box.
@@ -331,24 +336,63 @@ fn light_measure_known() -> bool {
     return !MANY_LIGHTS && cfg_mis_kind() == MIS_MULTI;
 }
 
-/// Block 2, the direction technique: the MIS weight of emission `found` along w, a direction it sampled from the
-/// shading point `from_p` (shading normal from_n; `from_transmits`: its BSDF transmits) with pdf p_dir, against
-/// the light technique's pdf of w (selection included). `known`: the measure of the first light sample taken at
-/// from_p.
-fn direction_mis_weight(p_dir: f32, found: Found, from_p: vec3<f32>, from_n: vec3<f32>, from_transmits: bool, w: vec3<f32>, known: LightMeasure) -> f32 {
+/// A direction technique's sample, as the emission it finds is weighted: the shading point it leaves (p, shading
+/// normal n; `transmits`: its BSDF does), its direction w and pdf, and the measure of the first light sample taken
+/// at p. `delta`: a delta lobe's sample, or the camera ray: no light technique competes, its emission counts in full.
+struct DirectionSample {
+    p: vec3<f32>,
+    n: vec3<f32>,
+    transmits: bool,
+    w: vec3<f32>,
+    pdf: f32,
+    delta: bool,
+    light: LightMeasure,
+}
+
+/// The MIS weight of emission `found` along direction sample s against the light technique's pdf of s.w (selection
+/// included).
+fn direction_mis_weight(s: DirectionSample, found: Found) -> f32 {
     if (!mis_on()) { return 1.0; }
     var p_light = 0.0;
     if (found.light == params.env_light) {
-        p_light = env_pdf(w, from_p, env_receiver(from_n, from_transmits));
+        p_light = env_pdf(s.w, s.p, env_receiver(s.n, s.transmits));
     } else {
-        var m = known;
-        if (!light_measure_known()) { m = light_measure(found.light, from_p); }
+        var m = s.light;
+        if (!light_measure_known()) { m = light_measure(found.light, s.p); }
         // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
-        p_light = light_pdf_li(found.light, m, from_p, env_receiver(from_n, from_transmits), w, found.surface.p, found.surface.ng);
+        p_light = light_pdf_li(found.light, m, s.p, env_receiver(s.n, s.transmits), s.w, found.surface.p, found.surface.ng);
     }
     // A convex lamp's face was found: the lamp is what light sampling chooses.
     let chosen = chosen_light(found.light);
-    return mis_weight(f32(params.bsdf_samples), p_dir, f32(params.light_samples), light_pmf(chosen, from_p, from_n) * p_light);
+    return mis_weight(f32(params.bsdf_samples), s.pdf, f32(params.light_samples), light_pmf(chosen, s.p, s.n) * p_light);
+}
+
+/// The emission `found` by direction sample s, × scale, × its MIS weight. The one place where emission a direction
+/// sample finds is weighted: for the samples shade() traces and for the path's continuation (integrator.wgsl).
+fn weighted_emission(s: DirectionSample, found: Found, scale: f32) -> vec3<f32> {
+    var w = scale;
+    if (w > 0.0 && !s.delta && any(found.le != vec3<f32>(0.0))) { w *= direction_mis_weight(s, found); }
+    return w * found.le;
+}
+
+/// Block 2, the direction technique: sample a direction, trace it, weight the emission it finds against the light
+/// technique's pdf. L·f·cos / pdf. `known`: the measure of the first light sample taken at c.
+fn direction_technique(c: ShadingCtx, j: u32, known: LightMeasure) -> vec3<f32> {
+    let ds = direction_sample(c, j);
+    if (!(ds.pdf > 0.0)) { return vec3<f32>(0.0); }
+    let w = to_world(c.frame, ds.wi);
+    if (wrong_side(c, w, ds.wi)) { return vec3<f32>(0.0); }
+    let o = spawn_origin(c.x, w);
+    if (finds_no_emission(o, w)) { return vec3<f32>(0.0); }
+    let s = DirectionSample(c.x.p, c.x.ns, bsdf_transmits(c.brdf), w, ds.pdf, ds.delta, known);
+    let found = trace_found(o, s, true);
+    if (all(found.le == vec3<f32>(0.0))) { return vec3<f32>(0.0); }
+    return weighted_emission(s, found, 1.0) * direction_f(c, ds) * abs(ds.wi.z) / ds.pdf;
+}
+
+/// The environment guide learns where the sky is seen from: direction sample s escaped to it.
+fn env_guide_learn_found(s: DirectionSample, found: Found) {
+    if (found.escaped && !s.delta) { env_guide_learn_escape(s.p, env_receiver(s.n, s.transmits), s.w); }
 }
 
 // ---- shade() ----
@@ -407,16 +451,13 @@ fn strategy_plan(c: ShadingCtx) -> Plan {
 }
 
 /// What shade() returns: the estimate it completed, and (path mode) direction sample 0 untraced — the path's
-/// continuation, whose emission the caller counts where its trace finds it, × next_scale × direction_mis_weight.
+/// continuation, whose emission the path loop weights where its trace finds it (`weighted_emission` × next_scale).
 struct Shaded {
     radiance: vec3<f32>,      // light samples and the direction samples traced here, weighted
-    light: LightMeasure,      // the first light sample's (for direction_mis_weight at the next vertex)
     next_valid: bool,
     next_origin: vec3<f32>,
-    next_dir: vec3<f32>,
-    next_weight: vec3<f32>,   // f·cos/pdf of next_dir
-    next_pdf: f32,
-    next_delta: bool,         // next_dir is a delta lobe's: its emission counts with MIS weight 1
+    next: DirectionSample,
+    next_weight: vec3<f32>,   // f·cos/pdf of next.w
     next_scale: f32,          // 0 where the strategy counts no direction sample here (light sampling, or one-sample
                               // MIS chose the light): then the direction only continues the path
 }
@@ -427,32 +468,18 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     var out: Shaded;
     let plan = strategy_plan(c);
     out.radiance = vec3<f32>(0.0);
-    out.light = LightMeasure(MEASURE_NONE, 0.0);
+    var known = LightMeasure(MEASURE_NONE, 0.0);
     for (var j = 0u; j < min(plan.light_runs, 64u); j += 1u) {
         let e = light_technique(c, j);
         out.radiance += e.radiance / plan.light_div;
-        if (j == 0u) { out.light = e.m; }
+        if (j == 0u) { known = e.m; }
     }
-    // Direction samples 1.. (--bsdf-samples > 1) are traced here; a pipeline for one sample compiles none. In direct
-    // mode sample 0 is traced here too: there is no path to continue, and one trace site (this one) per sample keeps
-    // a direct sample to one pass of the path loop (measured ~7 % faster on veach-mis than two).
+    // Direction samples 1.. are traced here (a pipeline for one sample compiles none), and sample 0 too in direct
+    // mode: no path continues, and one trace site per sample keeps a direct sample to one pass of the path loop.
     let all_here = cfg_mode() == MODE_DIRECT;
     if (SPEC_ONE_DIRECTION != 1u || all_here) {
         for (var j = select(1u, 0u, all_here); j < min(plan.dir_runs, 64u); j += 1u) {
-            let ds = direction_sample(c, j);
-            if (!(ds.pdf > 0.0)) { continue; }
-            let w = to_world(c.frame, ds.wi);
-            if (wrong_side(c, w, ds.wi)) { continue; }
-            let o = spawn_origin(c.x, w);
-            // Where the only emitters are a few convex lamps, a direction that meets none of them finds nothing.
-            if (finds_no_emission(o, w)) { continue; }
-            rays_traced += 1u;
-            let found = found_emission_only(o, w, c.x.p);
-            if (all(found.le == vec3<f32>(0.0))) { continue; }
-            let f = direction_f(c, ds);
-            var mis = 1.0;
-            if (!ds.delta) { mis = direction_mis_weight(ds.pdf, found, c.x.p, c.x.ns, bsdf_transmits(c.brdf), w, out.light); }
-            out.radiance += mis * found.le * f * abs(ds.wi.z) / ds.pdf * plan.dir_scale;
+            out.radiance += direction_technique(c, j, known) * plan.dir_scale;
         }
     }
     out.next_valid = false;
@@ -463,10 +490,8 @@ fn shade(c: ShadingCtx, want_next: bool) -> Shaded {
     if (wrong_side(c, w, ds.wi)) { return out; }
     out.next_valid = true;
     out.next_origin = spawn_origin(c.x, w);
-    out.next_dir = w;
+    out.next = DirectionSample(c.x.p, c.x.ns, bsdf_transmits(c.brdf), w, ds.pdf, ds.delta, known);
     out.next_weight = direction_f(c, ds) * abs(ds.wi.z) / ds.pdf;
-    out.next_pdf = ds.pdf;
-    out.next_delta = ds.delta;
     out.next_scale = select(0.0, plan.dir_scale, plan.dir_runs > 0u);
     return out;
 }

@@ -21,37 +21,27 @@ fn camera_direction(px: vec2<u32>, jitter: vec2<f32>) -> vec3<f32> {
 /// A path between two vertices: the ray whose hit is its next vertex, and how to count the emission found there.
 struct PathRay {
     id: SampleId,
-    bounce: u32,             // the vertex this ray finds
+    bounce: u32,              // the vertex this ray finds
     o: vec3<f32>,
-    d: vec3<f32>,
-    from_p: vec3<f32>,       // the shading point it leaves (for the light technique's pdf of what it finds)
-    from_n: vec3<f32>,       // its shading normal (the light tree's selection depends on it)
-    from_transmits: bool,    // its BSDF transmits (a constant environment's light sample then ignores from_n)
-    dir_pdf: f32,            // pdf of the direction technique that chose d
-    dir_delta: bool,         // d is a delta lobe's sample: no light technique competes, MIS weight 1
-    emission_scale: f32,     // factor on the emission it finds (0: not a counted direction sample)
-    light: LightMeasure,     // how the first light sample at from_p was drawn
-    beta: vec3<f32>,         // throughput, including f·cos/pdf of d
-    l: vec3<f32>,            // radiance gathered so far
+    sample: DirectionSample,  // its direction w, and how the emission it finds is weighted
+    emission_scale: f32,      // factor on the emission it finds (0: not a counted direction sample)
+    beta: vec3<f32>,          // throughput, including f·cos/pdf of w
+    l: vec3<f32>,             // radiance gathered so far
 }
 
 fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
-    var r: PathRay;
-    r.id = id;
-    r.bounce = 0u;
-    r.o = params.cam_origin;
     let filtered = filter_sample(sample_2d(id, 0u));
-    r.d = camera_direction(px, filtered.jitter);
-    r.from_p = params.cam_origin;
-    r.from_n = vec3<f32>(0.0);
-    r.from_transmits = false;
-    r.dir_pdf = 0.0;
-    r.dir_delta = false;
-    r.emission_scale = 1.0;
-    r.light = LightMeasure(MEASURE_NONE, 0.0);
-    r.beta = vec3<f32>(filtered.weight);
-    r.l = vec3<f32>(0.0);
-    return r;
+    let d = camera_direction(px, filtered.jitter);
+    // The camera ray is no direction technique's sample: like a delta lobe's, its emission counts in full.
+    let s = DirectionSample(params.cam_origin, vec3<f32>(0.0), false, d, 0.0, true, LightMeasure(MEASURE_NONE, 0.0));
+    return PathRay(id, 0u, params.cam_origin, s, 1.0, vec3<f32>(filtered.weight), vec3<f32>(0.0));
+}
+
+/// Russian roulette's survival probability after a vertex whose scattering weight f·cos/pdf is `weight`: its
+/// largest channel, at least 5 %. Not max(β) as in pbrt-v4 and Mitsuba 3: a survivor's β stays where it was when
+/// roulette began instead of being lifted back to 1 (docs/estimators.md, "Russian roulette").
+fn roulette_survival(weight: vec3<f32>) -> f32 {
+    return clamp(max(weight.x, max(weight.y, weight.z)), 0.05, 1.0);
 }
 
 /// Traces the path's ray, counts the emission it finds, shades the vertex there and sets the next ray. Returns
@@ -59,56 +49,31 @@ fn camera_ray(px: vec2<u32>, id: SampleId) -> PathRay {
 /// the ray leaving the last one is traced only for the emission it finds.
 fn path_vertex(r: ptr<function, PathRay>, depth: u32) -> bool {
     let ray = *r;
-    // A ray traced only for the emission it finds (a path's last, every direction sample in direct mode) finds none
-    // where the scene's only emitters are a few convex lamps and it meets none of their stop boxes: not traced.
-    let emission_only = ray.bounce > 0u && ray.bounce >= depth;
-    if (emission_only && finds_no_emission(ray.o, ray.d)) { return false; }
-    rays_traced += 1u;
-    // Such a ray towards a convex lamp's inner sphere is traced only up to the lamp's box (`lamp_in_sight`).
-    var sight = LampSighting(INVALID, vec3<f32>(0.0), F32_MAX);
-    if (emission_only) { sight = lamp_in_sight(ray.o, ray.d, ray.from_p); }
-    let hit = trace_closest(ray.o, ray.d, sight.t_box);
-    var found: Found;
-    if (lamp_sighted(sight, hit)) { found = lamp_found(sight); } else { found = found_emission(ray.o, ray.d, hit); }
-    // The camera ray is no direction technique's sample: its emission counts in full.
-    var w = ray.emission_scale;
-    if (ray.bounce > 0u && w > 0.0 && !ray.dir_delta && any(found.le != vec3<f32>(0.0))) {
-        w *= direction_mis_weight(ray.dir_pdf, found, ray.from_p, ray.from_n, ray.from_transmits, ray.d, ray.light);
-    }
-    (*r).l += ray.beta * (w * found.le);
-    if (hit.prim == INVALID && !lamp_sighted(sight, hit) && ray.bounce > 0u && !ray.dir_delta) {
-        env_guide_learn_escape(ray.from_p, env_receiver(ray.from_n, ray.from_transmits), ray.d);
-    }
-    if (hit.prim == INVALID || ray.bounce >= depth) { return false; }
+    // A path's last ray is traced only for the emission it finds: `trace_found` and `finds_no_emission` then cut it.
+    let last = ray.bounce > 0u && ray.bounce >= depth;
+    if (last && finds_no_emission(ray.o, ray.sample.w)) { return false; }
+    let found = trace_found(ray.o, ray.sample, last);
+    (*r).l += ray.beta * weighted_emission(ray.sample, found, ray.emission_scale);
+    env_guide_learn_found(ray.sample, found);
+    if (!found.at_surface || ray.bounce >= depth) { return false; }
     let x = found.surface;
-    let c = shading_ctx(x, scene_material(x.material), ray.d, ray.id, ray.bounce);
+    let c = shading_ctx(x, scene_material(x.material), ray.sample.w, ray.id, ray.bounce);
     let want_next = ray.bounce + 1u < depth;
     let s = shade(c, want_next);
     (*r).l += ray.beta * s.radiance;
     if (!s.next_valid) { return false; }
     var beta = ray.beta * s.next_weight;
+    // Roulette is decided before the ray is traced: a surviving path counts what it finds with β/q (as pbrt-v4).
     if (want_next && ray.bounce + 1u >= params.rr_depth) {
-        // Russian roulette, decided before the ray is traced: a surviving path counts what it finds with β/q (as
-        // pbrt-v4 does). Continue with probability this vertex's own scattering weight f·cos/pdf (largest channel,
-        // at least 5 %), not the whole throughput's max(β) as pbrt-v4 and Mitsuba 3 do: β is then held where it was
-        // when roulette began instead of being lifted back to 1, so no survivor carries 1/β₃ (8× on a grey 0.5
-        // scene) and far fewer paths die at the first roulette. Measured 1.3–1.4× as efficient (1 / (relMSE ·
-        // time)) on the interiors, the helmet and the Cornell box (docs/estimators.md, "Russian roulette").
-        let q = clamp(max(s.next_weight.x, max(s.next_weight.y, s.next_weight.z)), 0.05, 1.0);
+        let q = roulette_survival(s.next_weight);
         if (sample_1d(c.id, dim_base(ray.bounce, 0u) + DIM_RR) >= q) { return false; }
         beta /= q;
     }
     if (all(beta == vec3<f32>(0.0))) { return false; }
     (*r).bounce = ray.bounce + 1u;
     (*r).o = s.next_origin;
-    (*r).d = s.next_dir;
-    (*r).from_p = x.p;
-    (*r).from_n = x.ns;
-    (*r).from_transmits = bsdf_transmits(c.brdf);
-    (*r).dir_pdf = s.next_pdf;
-    (*r).dir_delta = s.next_delta;
+    (*r).sample = s.next;
     (*r).emission_scale = s.next_scale;
-    (*r).light = s.light;
     (*r).beta = beta;
     return true;
 }
@@ -145,14 +110,10 @@ fn render_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_inv
     var a = accum[pixel];
     var bad = 0u;
     if (cfg_mode() == MODE_PATH && (FLAT_SCENE || SPEC_MODE == MODE_PATH)) {
-        // One loop over path vertices, not one per sample: a lane whose path ends starts its next sample at
-        // once. lavapipe runs a loop's SIMD lanes until the last one is done, so with a loop per sample every
-        // lane waited for the longest path among its neighbours'. In direct mode (at most two vertices) the loop
-        // per sample below is faster. BVH scenes once measured 5–15 % faster with it too (lanes that restart apart
-        // walk the tree apart); since roulette keeps paths longer (2026-12-04) this loop is 0.85–0.94× the time on
-        // Mesa 25.0.7 and 0.93–1.0× on Mesa 22.3.6 there as well (docs/estimators.md, "One path loop"). Only where
-        // the mode is fixed at compile time for a BVH scene: a generic pipeline (the viewer's) would compile both
-        // loops, each with the whole traversal inlined, and lavapipe took 10 minutes over that instead of seconds.
+        // One loop over path vertices, not one per sample: a lane whose path ends starts its next sample at once,
+        // instead of waiting for the longest path among its SIMD neighbours'. Only where the mode is fixed at compile
+        // time for a BVH scene: a generic pipeline (the viewer's) would compile both loops, each with the whole
+        // traversal inlined, and lavapipe takes minutes over that (docs/estimators.md, "One path loop").
         var ray = camera_ray(px, SampleId(pixel, params.sample_base));
         var started = 1u;
         var done = 0u;
