@@ -1,4 +1,4 @@
-//! Baked occluders (src/render/scene_data.rs `occluder_split`): a scene of a few occluders among many emitter
+//! Baked occluders (src/render/scene_data/mod.rs `occluder_split`): a scene of a few occluders among many emitter
 //! triangles has its occluders as literals in its pipeline and only the emitters in the BVH, and a ray traced only
 //! for its emission towards a convex lamp's inner sphere is traced no further than the lamp's box
 //! (shaders/lights.wgsl `lamp_in_sight`). Neither may change what a ray finds: BSDF samples give the same pixels

@@ -1254,7 +1254,7 @@ fn wide_build_invariants() {
 }
 
 /// A triangle-only scene uploads `IDENTITY_PRIM_REFS` instead of its references, which are then the identity
-/// (src/render/scene_data.rs): the generic traversal, which reads `prim_refs`, must find the same hits with it as
+/// (src/render/scene_data/mod.rs): the generic traversal, which reads `prim_refs`, must find the same hits with it as
 /// with the identity uploaded.
 #[test]
 fn gpu_identity_prim_refs_read_as_the_leaf_order() {

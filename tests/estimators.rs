@@ -1102,7 +1102,7 @@ fn light_tree_and_ris_agree_on_the_veach_gltf_scene() {
 /// A coarsely tessellated sphere lamp (120 faces: the rim outside its inner sphere is 13 % of its silhouette) over
 /// a grey floor, in front of a grey wall, with a shelf between the lamp and the floor: rays towards the lamp that
 /// the shelf blocks before the lamp's box (shaders/lights.wgsl `lamp_in_sight`). Six occluder triangles among 120
-/// emitters: the occluders are baked (src/render/scene_data.rs `occluder_split`).
+/// emitters: the occluders are baked (src/render/scene_data/mod.rs `occluder_split`).
 fn lamp_room() -> Scene {
     let floor = rect(Vec3::new(-3.0, 0.0, 2.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0));
     let wall = rect(Vec3::new(-3.0, 0.0, -2.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));

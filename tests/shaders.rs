@@ -100,8 +100,8 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         assert_eq!(count(&all, &format!("LIGHT_{k}")), ops.len(), "LIGHT_{k} is named outside the light dispatchers");
     }
     assert_eq!(count(&all, ".kind"), ops.len(), "something besides the dispatchers reads a light's kind");
-    // Rust: the tag is defined in gpu/types.rs, turned into table entries in render/light_table.rs (and counted in
-    // render/scene_data.rs) and into HAS_*
+    // Rust: the tag is defined in gpu/types.rs, turned into table entries in render/scene_data/light_table.rs (and counted in
+    // render/scene_data/mod.rs) and into HAS_*
     // flags in render/features.rs, and named in no other file of src/.
     let mut files = Vec::new();
     let mut stack = vec![dir.join("src")];
@@ -120,7 +120,7 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         let name = f.strip_prefix(dir.join("src")).unwrap().to_str().unwrap().replace('\\', "/");
         if kinds.iter().any(|k| text.contains(&format!("LIGHT_{k}"))) {
             assert!(
-                ["gpu/types.rs", "render/scene_data.rs", "render/light_table.rs", "render/features.rs"]
+                ["gpu/types.rs", "render/scene_data/mod.rs", "render/scene_data/light_table.rs", "render/features.rs"]
                     .contains(&name.as_str()),
                 "{} names a light kind: adding one would have to touch it too",
                 f.display()

@@ -61,13 +61,6 @@ pub enum GpuError {
     VerticesTooLarge { bytes: u64, bindings: usize, limit: u64 },
 }
 
-/// Layers above that still speak in messages take a GPU error as its message.
-impl From<GpuError> for String {
-    fn from(e: GpuError) -> String {
-        e.to_string()
-    }
-}
-
 /// One adapter as `mislab info` prints it.
 #[derive(Clone, Debug)]
 pub struct AdapterSummary {

@@ -21,8 +21,7 @@ use glam::Vec3;
 use std::collections::HashMap;
 use std::fmt::Write;
 
-/// Largest primitive count rendered without a BVH (`Features::flat`).
-pub const FLAT_MAX_PRIMS: usize = 32;
+pub use crate::render::scene_data::FLAT_MAX_PRIMS;
 
 /// (triangles, spheres, quads) of a scene small enough to test every primitive without a BVH.
 pub fn flat_counts(data: &SceneData) -> Option<(u32, u32, u32)> {

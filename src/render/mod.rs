@@ -10,7 +10,6 @@ pub mod error;
 pub mod features;
 pub mod film;
 pub mod gpu_scene;
-pub mod light_table;
 pub mod lights;
 pub mod materials;
 pub mod pipeline_cache;

@@ -4,11 +4,15 @@
 use crate::accel::{bvh, wide_bvh};
 use crate::accel::light_tree::GpuLightNode;
 use crate::gpu::types::*;
-use crate::render::light_table;
 use crate::render::shading_data::{material_word, word_material, ShadingTable};
 use crate::scene::{Scene, TextureRef, Wrap};
 use glam::{Vec2, Vec3};
 
+mod light_table;
+
+
+/// Largest primitive count rendered without a BVH (`Features::flat`, `render::baked`).
+pub const FLAT_MAX_PRIMS: usize = 32;
 /// `tri_lights` of a scene where no triangle emits. Four words, not one: a storage buffer is at least 16 bytes
 /// (`GpuContext::storage_buffer_bytes` pads with zeros), and the shader clamps its index to the buffer's length, so
 /// every word the shader can reach must say INVALID (a zero padding word would read as light 0).
@@ -221,7 +225,7 @@ impl SceneData {
         // triangle) and emitters (a shadow ray towards one skips it by its index).
         let emits = |i: usize| d.materials[d.tri_material(i) as usize].emission.iter().any(|&c| c > 0.0);
         let keep_whole: Vec<bool> = (0..tris.len()).map(emits).collect();
-        let presplit = if tris.len() + d.spheres.len() + d.quads.len() > crate::render::baked::FLAT_MAX_PRIMS {
+        let presplit = if tris.len() + d.spheres.len() + d.quads.len() > FLAT_MAX_PRIMS {
             bvh::Presplit::Large { keep_whole: &keep_whole }
         } else {
             bvh::Presplit::Off
@@ -366,8 +370,8 @@ impl SceneData {
 /// triangle-only), cut-out masks (the baked tests have no alpha test), or without `on`.
 pub fn occluder_split(emits: &[bool], analytic_prims: usize, alpha: bool, on: bool) -> Option<Vec<usize>> {
     let occluders: Vec<usize> = (0..emits.len()).filter(|&i| !emits[i]).collect();
-    let fits = !occluders.is_empty() && occluders.len() <= crate::render::baked::FLAT_MAX_PRIMS;
-    (on && fits && !alpha && analytic_prims == 0 && emits.len() > crate::render::baked::FLAT_MAX_PRIMS)
+    let fits = !occluders.is_empty() && occluders.len() <= FLAT_MAX_PRIMS;
+    (on && fits && !alpha && analytic_prims == 0 && emits.len() > FLAT_MAX_PRIMS)
         .then_some(occluders)
 }
 
