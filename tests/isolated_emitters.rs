@@ -111,6 +111,7 @@ fn sphere_over_plates(far: bool) -> (Scene, usize) {
             forward: (Vec3::new(0.0, 0.6, 0.0) - Vec3::new(2.5, 3.5, 3.5)).normalize(),
             up: Vec3::Y,
             vfov: 50f32.to_radians(),
+            window: Camera::FULL_WINDOW,
         },
         ..Default::default()
     };

@@ -483,6 +483,7 @@ impl Renderer {
     pub fn frame_params(&self, spp: u32) -> GpuFrameParams {
         let s = &self.settings;
         let (right, up, forward) = self.camera.frame();
+        let (forward, tan_half_fov) = self.camera.cropped_view(forward, right, up, s.width, s.height);
         GpuFrameParams {
             width: s.width,
             height: s.height,
@@ -506,7 +507,7 @@ impl Renderer {
             rr_depth: s.rr_depth,
             env_light: self.env_light,
             cam_origin: (self.camera.position - self.origin).into(),
-            tan_half_fov: (0.5 * self.camera.vfov).tan(),
+            tan_half_fov,
             cam_right: right.into(),
             aspect: s.width as f32 / s.height as f32,
             cam_up: up.into(),

@@ -172,6 +172,10 @@ pub fn scene_hash(data: &SceneData, camera: &Camera) -> String {
         h.write_pod(&v.to_array());
     }
     h.write_pod(&[camera.vfov]);
+    // A film crop is a different image; the whole film hashes as it did before crops existed.
+    if camera.window != Camera::FULL_WINDOW {
+        h.write_pod(&camera.window);
+    }
     format!("{:016x}", h.finish())
 }
 

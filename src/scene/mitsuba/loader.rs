@@ -672,18 +672,29 @@ impl Loader {
             None => "x".into(),
         };
         let (mut w, mut h) = (768u32, 576u32);
+        // Mitsuba 3's film crop: crop_offset_x/y (default 0) and crop_width/height (default the film's size).
+        let (mut crop_offset, mut crop_size) = ([0u32; 2], [None::<u32>; 2]);
+        let mut crop_at = None;
         if let Some(film) = e.children.iter().find(|c| c.tag == "film") {
             for c in &film.children {
-                let v = || -> Result<u32, SceneError> {
+                let v = |min: f64| -> Result<u32, SceneError> {
                     let n = self.numbers(file, c, &self.need(file, c, "value")?)?;
                     match n.first() {
-                        Some(&v) if (1.0..=16384.0).contains(&v) && v.fract() == 0.0 => Ok(v as u32),
-                        _ => Err(self.err(file, c, "film size must be an integer in 1..=16384")),
+                        Some(&v) if (min..=16384.0).contains(&v) && v.fract() == 0.0 => Ok(v as u32),
+                        _ => Err(self.err(file, c, format!("film size must be an integer in {min}..=16384"))),
                     }
                 };
                 match c.attr("name") {
-                    Some("width") => w = v()?,
-                    Some("height") => h = v()?,
+                    Some("width") => w = v(1.0)?,
+                    Some("height") => h = v(1.0)?,
+                    Some(name @ ("crop_offset_x" | "crop_offset_y")) => {
+                        crop_offset[(name == "crop_offset_y") as usize] = v(0.0)?;
+                        crop_at = Some(c);
+                    }
+                    Some(name @ ("crop_width" | "crop_height")) => {
+                        crop_size[(name == "crop_height") as usize] = Some(v(1.0)?);
+                        crop_at = Some(c);
+                    }
                     _ => {}
                 }
             }
@@ -734,8 +745,23 @@ impl Loader {
         let position = to_world.transform_point3(DVec3::ZERO).as_vec3();
         let forward = to_world.transform_vector3(DVec3::Z).normalize().as_vec3();
         let up = to_world.transform_vector3(DVec3::Y).normalize().as_vec3();
-        self.b.scene.camera = Camera { position, forward, up, vfov: (2.0 * vhalf.atan()) as f32 };
+        self.b.scene.camera = Camera { position, forward, up, vfov: (2.0 * vhalf.atan()) as f32, window: Camera::FULL_WINDOW };
         self.b.scene.film_size = Some([w, h]);
+        if let Some(c) = crop_at {
+            let [cw, ch] = [crop_size[0].unwrap_or(w), crop_size[1].unwrap_or(h)];
+            let [ox, oy] = crop_offset;
+            if ox + cw > w || oy + ch > h {
+                return Err(self.err(
+                    file,
+                    c,
+                    format!("the film crop ({cw}x{ch} at {ox}, {oy}) does not fit the {w}x{h} film"),
+                ));
+            }
+            let (fw, fh) = (w as f32, h as f32);
+            self.b.scene.camera.window = [ox as f32 / fw, (ox + cw) as f32 / fw, oy as f32 / fh, (oy + ch) as f32 / fh];
+            self.b.scene.film_size = Some([cw, ch]);
+            self.b.count("film crop (the image is that part of the film)", 1);
+        }
         self.b.count("camera (perspective)", 1);
         for c in &e.children {
             if !matches!(c.tag.as_str(), "transform" | "film" | "sampler")

@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::sync::Arc;
 
+mod film;
 mod textures;
 
 /// pbrt's world → mislab's when pbrt's camera frame is a proper rotation (a `LookAt`, say). pbrt's camera space
@@ -113,6 +114,8 @@ pub struct Parser {
     includes: Vec<PathBuf>,
     camera: Option<(DMat4, f64)>,
     film: [u32; 2],
+    /// The film's crop, in pixels `[x0, x1, y0, y1]` (`parser/film.rs`).
+    crop: Option<[u32; 4]>,
     env_lights: usize,
     /// pbrt's world → mislab's: the identity, or MIRROR_X under a camera that keeps pbrt's left-handed frame.
     mirror: DMat4,
@@ -148,6 +151,7 @@ impl Parser {
             includes: vec![],
             camera: None,
             film: [1280, 720],
+            crop: None,
             env_lights: 0,
             mirror: DMat4::IDENTITY,
         }
@@ -189,13 +193,18 @@ impl Parser {
                     "the camera's position or direction is out of the range of 32-bit floats",
                 ));
             }
-            scene_camera = Camera { position, forward, up, vfov: vfov as f32 };
+            scene_camera = Camera { position, forward, up, vfov: vfov as f32, window: Camera::FULL_WINDOW };
             self.b.count("camera (perspective)", 1);
         } else {
             self.b.ignore("no Camera directive: mislab's default camera is used");
         }
         self.b.scene.camera = scene_camera;
         self.b.scene.film_size = Some([w, h]);
+        if let Some([x0, x1, y0, y1]) = self.crop {
+            let (fw, fh) = (w as f32, h as f32);
+            self.b.scene.camera.window = [x0 as f32 / fw, x1 as f32 / fw, y0 as f32 / fh, y1 as f32 / fh];
+            self.b.scene.film_size = Some([x1 - x0, y1 - y0]);
+        }
         self.b.scene.name = self.main.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         Ok(self.b.finish("pbrt-v4"))
     }
@@ -444,6 +453,14 @@ impl Parser {
                 }
                 self.film = [w as u32, h as u32];
                 self.b.count("film size (the default image size)", 1);
+                let (crop, warning) = film::pixel_bounds(&p, w as u32, h as u32)?;
+                self.crop = crop;
+                if let Some(w) = warning {
+                    self.b.scene.warnings.push(format!("{}: line {}: {w}", p.file.display(), p.line));
+                }
+                if crop.is_some() {
+                    self.b.count("film crop (the image is that part of the film)", 1);
+                }
                 p.has("filename");
             }
             "Texture" => self.texture(kind, extra.as_deref().unwrap_or(""), class.as_deref().unwrap_or(""), &p)?,

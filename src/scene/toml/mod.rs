@@ -404,7 +404,7 @@ fn camera(ctx: &Ctx, c: &Spanned<CameraDef>) -> Result<Camera, SceneError> {
     if !(vfov > 0.0 && vfov < 180.0) {
         return Err(e(&format!("vfov must be between 0 and 180 degrees (got {vfov})")));
     }
-    Ok(Camera { position, forward, up, vfov: vfov.to_radians() })
+    Ok(Camera { position, forward, up, vfov: vfov.to_radians(), window: Camera::FULL_WINDOW })
 }
 
 fn light(ctx: &Ctx, i: usize, l: &Spanned<LightDef>) -> Result<PunctualLight, SceneError> {
