@@ -26,9 +26,8 @@ fn load(path: &std::path::Path) -> Scene {
 /// parameters on the Film statement.
 fn pbrt(name: &str, film: &str) -> Scene {
     let mut quads = String::new();
-    for (k, (x, y)) in [(-0.3, -0.2), (0.05, -0.15), (0.2, 0.1), (-0.15, 0.12), (0.32, -0.25), (-0.05, 0.3)]
-        .into_iter()
-        .enumerate()
+    for (k, (x, y)) in
+        [(-0.3, -0.2), (0.05, -0.15), (0.2, 0.1), (-0.15, 0.12), (0.32, -0.25), (-0.05, 0.3)].into_iter().enumerate()
     {
         let s = 0.06 + 0.02 * k as f64;
         quads += &format!(
@@ -66,10 +65,13 @@ fn pbrt_and_mitsuba_crops_are_read_as_their_renderers_read_them() {
     let both = pbrt("both.pbrt", r#""integer pixelbounds" [ 0 8 0 8 ] "float cropwindow" [ 0.25 0.75 0.5 1 ]"#);
     assert_eq!(both.camera.window, window.camera.window);
     assert!(both.warnings.iter().any(|w| w.contains("cropwindow")), "{:?}", both.warnings);
-    let empty = write("empty.pbrt", &format!(
-        "Camera \"perspective\"\nFilm \"rgb\" \"integer xresolution\" [ {W} ] \"integer yresolution\" [ {H} ] \
+    let empty = write(
+        "empty.pbrt",
+        &format!(
+            "Camera \"perspective\"\nFilm \"rgb\" \"integer xresolution\" [ {W} ] \"integer yresolution\" [ {H} ] \
          \"float cropwindow\" [ 0.5 0.5 0 1 ]\nWorldBegin\n"
-    ));
+        ),
+    );
     let e = scene::load(empty.to_str().unwrap(), &LoadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("empty.pbrt") && e.contains("leaves no pixel"), "{e}");
 
@@ -88,10 +90,15 @@ fn pbrt_and_mitsuba_crops_are_read_as_their_renderers_read_them() {
     };
     let m = load(&write(
         "crop.xml",
-        &xml(r#"<integer name="crop_offset_x" value="16"/><integer name="crop_offset_y" value="24"/><integer name="crop_width" value="32"/><integer name="crop_height" value="24"/>"#),
+        &xml(
+            r#"<integer name="crop_offset_x" value="16"/><integer name="crop_offset_y" value="24"/><integer name="crop_width" value="32"/><integer name="crop_height" value="24"/>"#,
+        ),
     ));
     assert_eq!((m.film_size, m.camera.window), (Some([32, 24]), [0.25, 0.75, 0.5, 1.0]));
-    let bad = write("bad-crop.xml", &xml(r#"<integer name="crop_offset_x" value="40"/><integer name="crop_width" value="32"/>"#));
+    let bad = write(
+        "bad-crop.xml",
+        &xml(r#"<integer name="crop_offset_x" value="40"/><integer name="crop_width" value="32"/>"#),
+    );
     let e = scene::load(bad.to_str().unwrap(), &LoadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("bad-crop.xml") && e.contains("does not fit"), "{e}");
 }
@@ -132,5 +139,8 @@ fn a_cropped_render_is_the_same_pixels_of_the_full_render() {
     }
     assert!(lit >= 3, "the crop should see some of the emitters ({lit} lit blocks)");
     assert!(worst < 0.03, "a cropped block differs from the full render's by {worst}");
-    assert!(misplaced > 0.2, "the full render's top-left corner looks like the crop ({misplaced}): the test cannot tell");
+    assert!(
+        misplaced > 0.2,
+        "the full render's top-left corner looks like the crop ({misplaced}): the test cannot tell"
+    );
 }

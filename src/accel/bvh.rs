@@ -126,7 +126,6 @@ pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
     order
 }
 
-
 /// obvhs build settings: its "slow" preset's PLOC search (24 neighbours), without obvhs's own pre-splits (mislab
 /// splits before, with conservative boxes: [`crate::accel::presplit`]), with leaves of at most 4 primitives
 /// collapsed by the SAH with traversal cost 1 (our node tests two boxes per fetch; an intersection costs about as

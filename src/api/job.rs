@@ -6,9 +6,9 @@ use super::error::ApiError;
 use super::flags::RenderFlags;
 use super::scene::SceneHandle;
 use crate::render::samplers::check_spp;
-use crate::state::StateError;
 use crate::render::settings::{Mode, PixelFilter, SamplerKind, Settings};
 use crate::state::session::Session;
+use crate::state::StateError;
 use crate::state::StateHeader;
 use std::path::Path;
 

@@ -15,8 +15,7 @@ pub fn merge(paths: &[PathBuf], state: Option<&Path>) -> Result<Image, ApiError>
     let parts = paths
         .iter()
         .map(|p| RenderState::read(p).map(|state| Part { path: p.clone(), state }))
-        .collect::<Result<Vec<_>, _>>()
-        ?;
+        .collect::<Result<Vec<_>, _>>()?;
     let parts = check_parts(parts)?;
     let merged = merge_parts(&parts);
     if let Some(path) = state {

@@ -203,8 +203,7 @@ pub fn resolve_inside(base: &Path, rel: &Path, allow_outside: bool) -> Result<Pa
 /// `read_bounded` for UTF-8 text.
 pub fn read_bounded_text(path: &Path, limit: u64) -> Result<String, InputError> {
     let bytes = read_bounded(path, limit)?;
-    String::from_utf8(bytes)
-        .map_err(|e| InputError::NotUtf8 { offset: e.utf8_error().valid_up_to() })
+    String::from_utf8(bytes).map_err(|e| InputError::NotUtf8 { offset: e.utf8_error().valid_up_to() })
 }
 
 /// Cuts text echoed from an input (a key, a name, a URI) to at most `max` characters, marking the cut.

@@ -113,7 +113,8 @@ pub fn replace_atomically<E: std::fmt::Display>(
 impl OutputTarget {
     /// Writes the output through `write` (given the temporary path to create) and renames it into place.
     pub fn write<E: std::fmt::Display>(&self, write: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), OutputError> {
-        replace_atomically(&self.file, write).map_err(|message| OutputError::Write { path: self.given.clone(), message })
+        replace_atomically(&self.file, write)
+            .map_err(|message| OutputError::Write { path: self.given.clone(), message })
     }
 }
 

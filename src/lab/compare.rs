@@ -77,7 +77,10 @@ pub fn read(path: &Path) -> Result<Image, LabError> {
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if !matches!(ext.as_deref(), Some("exr") | Some("state")) {
         // PNG holds tonemapped sRGB, not radiance: comparing it would measure the tonemapper.
-        return Err(LabError::Input(format!("{}: compare reads linear images (.exr, or a render .state)", path.display())));
+        return Err(LabError::Input(format!(
+            "{}: compare reads linear images (.exr, or a render .state)",
+            path.display()
+        )));
     }
     let r = crate::lab::reference::read_exr(path)?;
     if r.width == 0 || r.height == 0 {
@@ -118,7 +121,9 @@ pub fn compare(image: &Image, reference: &Image, block: u32) -> Result<Compariso
         )));
     }
     if block % k != 0 {
-        return Err(LabError::Input(format!("--block {block} is not a multiple of the size factor {k} between the images")));
+        return Err(LabError::Input(format!(
+            "--block {block} is not a multiple of the size factor {k} between the images"
+        )));
     }
     let (mi, iw, ih) = block_means(image, block / k);
     let (mr, rw, rh) = block_means(reference, block);

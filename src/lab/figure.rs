@@ -11,8 +11,8 @@
 //!   uniform, power, light-tree, RIS and tree-candidate RIS light selection, at equal time (`--time` per panel, default 4 s): which
 //!   light a sample picks decides the noise.
 
-use crate::lab::LabError;
 use crate::api;
+use crate::lab::LabError;
 use crate::render::film::Tonemap;
 use crate::render::settings::{Heuristic, LightSampling, LightSelect, Settings, Strategy};
 use std::path::PathBuf;
@@ -108,7 +108,9 @@ fn layout(which: &str, base: &Settings) -> Result<(&'static str, u32, Vec<Panel>
             })
             .collect(),
         )),
-        "samplers" => Err(LabError::Input("figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into())),
+        "samplers" => Err(LabError::Input(
+            "figure 'samplers' is drawn from the samplers' CPU twins, not rendered in panels".into(),
+        )),
         other => Err(LabError::Input(format!("unknown figure '{other}' (expected one of: {})", FIGURES.join(", ")))),
     }
 }
@@ -135,7 +137,10 @@ pub fn run(args: &FigureArgs) -> Result<(), LabError> {
     }
     let ext = args.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if ext.as_deref() != Some("png") {
-        return Err(LabError::Input(format!("{}: figures are written as PNG (use a .png name)", args.output.display())));
+        return Err(LabError::Input(format!(
+            "{}: figures are written as PNG (use a .png name)",
+            args.output.display()
+        )));
     }
     let spp = args.spp.unwrap_or(64);
     if spp == 0 {

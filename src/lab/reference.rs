@@ -3,10 +3,10 @@
 //! (custom attributes); and reading such references back for `mislab bench`.
 
 pub use crate::api::header_attributes;
-use crate::lab::LabError;
 use crate::api::{self, Budget, RenderStats};
 use crate::gpu::GpuContext;
 pub use crate::io::exr_image::ReferenceImage;
+use crate::lab::LabError;
 use crate::render::film::Film;
 use crate::render::settings::*;
 use crate::scene::{Scene, SceneSpec};

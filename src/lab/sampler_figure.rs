@@ -4,8 +4,8 @@
 //! centre, relative to white noise) — the lecture's Halton/Hammersley and blue-noise slides. Computed with the
 //! CPU twins of the WGSL samplers (src/render/samplers.rs), which tests/samplers.rs checks against the device.
 
-use crate::lab::LabError;
 use crate::lab::bench::plot::{self, Figure};
+use crate::lab::LabError;
 use crate::render::samplers::{self, SamplerParams, DIMS_CAMERA};
 use crate::render::settings::SamplerKind;
 use plotters::coord::Shift;

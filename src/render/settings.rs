@@ -294,7 +294,10 @@ impl Settings {
     /// Checks values that the type system does not: sizes, counts, β.
     pub fn validate(&self) -> Result<(), InvalidSettings> {
         if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 {
-            return Err(InvalidSettings(format!("image size {}x{} is out of range (1..=16384 per side)", self.width, self.height)));
+            return Err(InvalidSettings(format!(
+                "image size {}x{} is out of range (1..=16384 per side)",
+                self.width, self.height
+            )));
         }
         if !(self.power_beta.is_finite() && self.power_beta > 0.0 && self.power_beta <= 16.0) {
             return Err(InvalidSettings(format!("--power-beta {} is out of range (0, 16]", self.power_beta)));
@@ -322,7 +325,10 @@ impl Settings {
             return Err(InvalidSettings(format!("--filter-radius {radius} is out of range (0.05 to 16 pixels)")));
         }
         if !(self.filter_sigma.is_finite() && (0.05..=16.0).contains(&self.filter_sigma)) {
-            return Err(InvalidSettings(format!("--filter-sigma {} is out of range (0.05 to 16 pixels)", self.filter_sigma)));
+            return Err(InvalidSettings(format!(
+                "--filter-sigma {} is out of range (0.05 to 16 pixels)",
+                self.filter_sigma
+            )));
         }
         if self.max_depth == 0 || self.max_depth > 256 {
             return Err(InvalidSettings(format!("--max-depth {} is out of range (1..=256)", self.max_depth)));

@@ -68,7 +68,10 @@ impl SceneSpec {
     /// storage-binding limit, textures it cannot hold are refused before they are decoded.
     pub fn load(&self, storage_binding_limit: Option<u64>) -> Result<Scene, LoadError> {
         if !(self.env_scale.is_finite() && self.env_scale >= 0.0 && self.env_scale <= 1e30) {
-            return Err(LoadError::Flag(format!("--env-scale {} must be a finite number in [0, 1e30]", self.env_scale)));
+            return Err(LoadError::Flag(format!(
+                "--env-scale {} must be a finite number in [0, 1e30]",
+                self.env_scale
+            )));
         }
         if !self.env_rotation.is_finite() {
             return Err(LoadError::Flag(format!(

@@ -50,7 +50,10 @@ pub fn check_parts(mut parts: Vec<Part>) -> Result<Vec<Part>, StateError> {
     let (name0, h0) = (first.path.display().to_string(), first.state.header.clone());
     for p in &parts[1..] {
         if let Some(d) = p.state.header.differences(&h0) {
-            return Err(StateError::Mismatch(format!("{}: a foreign part (not of the render {name0} is of): {d}", p.path.display())));
+            return Err(StateError::Mismatch(format!(
+                "{}: a foreign part (not of the render {name0} is of): {d}",
+                p.path.display()
+            )));
         }
     }
     for (i, a) in parts.iter().enumerate() {

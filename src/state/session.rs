@@ -79,13 +79,17 @@ impl Session {
         let every = match args.checkpoint_every {
             None => None,
             Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
-            Some(t) => return Err(StateError::Flags(format!("--checkpoint-every {t} must be a positive number of seconds"))),
+            Some(t) => {
+                return Err(StateError::Flags(format!("--checkpoint-every {t} must be a positive number of seconds")))
+            }
         };
         let path = match (args.state.clone().or_else(|| args.resume.clone()), output) {
             (Some(path), _) => path,
             (None, Some(output)) => output.with_extension("state"),
             (None, None) => {
-                return Err(StateError::Flags("--part and --checkpoint-every need --state FILE (the state file to write)".into()))
+                return Err(StateError::Flags(
+                    "--part and --checkpoint-every need --state FILE (the state file to write)".into(),
+                ))
             }
         };
         check_state_path(&path, output)?;

@@ -15,7 +15,6 @@ pub struct ErrorMetrics {
     pub mae: f64,
 }
 
-
 /// Why two images cannot be compared.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MetricsError {

@@ -2,10 +2,10 @@
 //! image the window shows, plus per-workgroup statistics sums; the false-colour scale's CPU twin for the
 //! legend.
 
-use crate::viewer::ViewerError;
 use crate::gpu::types::GpuAccum;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::film::Tonemap;
+use crate::viewer::ViewerError;
 use bytemuck::{Pod, Zeroable};
 
 /// WGSL files of the display entry point, in order.

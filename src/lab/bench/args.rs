@@ -1,7 +1,7 @@
 //! The `mislab bench` flags and the groups they describe (comma lists, a TOML file or a built-in suite).
 
-use crate::lab::LabError;
 use super::*;
+use crate::lab::LabError;
 
 /// `mislab bench` flags.
 #[derive(clap::Args, Clone, Debug)]
@@ -103,8 +103,10 @@ impl BenchArgs {
                 )
             }
             (None, Some(path)) => {
-                let text = std::fs::read_to_string(path).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
-                let file: BenchFile = toml::from_str(&text).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
+                let text =
+                    std::fs::read_to_string(path).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
+                let file: BenchFile =
+                    toml::from_str(&text).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
                 if file.group.is_empty() {
                     return Err(LabError::Input(format!("{}: no [[group]] tables", path.display())));
                 }

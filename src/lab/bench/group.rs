@@ -1,8 +1,8 @@
 //! A benchmark group: one scene, film, mode, ladder and seeds, and the settings lists whose cross product are its
 //! configurations.
 
-use crate::lab::LabError;
 use super::*;
+use crate::lab::LabError;
 
 /// One comparison: a scene, film, mode, ladder and seeds, and the settings lists whose cross product are its
 /// configurations. The TOML file's `[[group]]` tables have these fields.
@@ -215,17 +215,24 @@ impl BenchGroup {
             return Err(LabError::Input(format!("group '{}': seeds must be at least 1", self.name)));
         }
         if self.time.is_none() && (self.spp.is_empty() || self.spp.contains(&0)) {
-            return Err(LabError::Input(format!("group '{}': the spp ladder must be non-empty and positive", self.name)));
+            return Err(LabError::Input(format!(
+                "group '{}': the spp ladder must be non-empty and positive",
+                self.name
+            )));
         }
         if let Some(t) = self.time {
             if !(t.is_finite() && t > 0.0) {
-                return Err(LabError::Input(format!("group '{}': time {t} must be a positive number of seconds", self.name)));
+                return Err(LabError::Input(format!(
+                    "group '{}': time {t} must be a positive number of seconds",
+                    self.name
+                )));
             }
         }
         for &ris_candidates in &self.ris_candidates {
             let s = Settings { ris_candidates, ..Settings::default() };
             s.validate().map_err(|e| LabError::Input(format!("group '{}': {e}", self.name)))?;
         }
-        Ok(Settings { width: self.width, height: self.height, max_depth: self.max_depth, ..Settings::default() }.validate()?)
+        Ok(Settings { width: self.width, height: self.height, max_depth: self.max_depth, ..Settings::default() }
+            .validate()?)
     }
 }

@@ -17,9 +17,9 @@ mod runner;
 mod suite;
 mod ticks;
 
+use crate::lab::LabError;
 pub use args::BenchArgs;
 pub use group::{BenchFile, BenchGroup};
-use crate::lab::LabError;
 use output::write_outputs;
 use results::summarize;
 pub use results::{to_csv, BenchRow, ConfigSummary, CSV_COLUMNS};

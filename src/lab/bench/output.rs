@@ -1,7 +1,7 @@
 //! Writing a run's results: results.csv, results.json, summary.md and the plots.
 
-use crate::lab::LabError;
 use super::*;
+use crate::lab::LabError;
 
 pub(super) fn write_outputs(out: &Path, ctx: &GpuContext, results: &[GroupResult]) -> Result<(), LabError> {
     let rows: Vec<BenchRow> = results.iter().flat_map(|r| r.rows.clone()).collect();

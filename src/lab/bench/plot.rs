@@ -1,9 +1,9 @@
 //! Plots (plotters): PNG through an in-memory RGB bitmap encoded by `image`, and SVG. Text uses egui's Hack
 //! font, registered with plotters' ab_glyph text backend (no system fonts needed).
 
-use crate::lab::LabError;
 use super::ticks;
 use super::ConfigSummary;
+use crate::lab::LabError;
 use plotters::coord::combinators::{BindKeyPoints, LogCoord, WithKeyPoints};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -42,7 +42,8 @@ pub fn save_png(path: &Path, (w, h): (u32, u32), figure: &impl Figure) -> Result
         figure.draw(&root)?;
         root.present().map_err(|e| LabError::Plot(e.to_string()))?;
     }
-    image::save_buffer(path, &buf, w, h, image::ExtendedColorType::Rgb8).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))
+    image::save_buffer(path, &buf, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(|e| LabError::Input(format!("{}: {e}", path.display())))
 }
 
 /// Writes `figure` as SVG.

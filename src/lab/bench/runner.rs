@@ -1,8 +1,8 @@
 //! Running a group: its reference (given or rendered and cached), then every configuration over the spp ladder and
 //! the seeds, timed per dispatch.
 
-use crate::lab::LabError;
 use super::*;
+use crate::lab::LabError;
 
 // ---------------------------------------------------------------------------------------------------------------
 // Running.
@@ -179,7 +179,9 @@ pub fn run_configurations(
                         eprintln!("  lavapipe's loop budget dropped samples at {spp} spp; retrying with {dispatch_spp} spp per dispatch");
                     }
                     Err(SeedError::Incomplete(spp)) => {
-                        return Err(LabError::Input(format!("{label}: pixels miss samples at {spp} spp even with 1 spp per dispatch")))
+                        return Err(LabError::Input(format!(
+                            "{label}: pixels miss samples at {spp} spp even with 1 spp per dispatch"
+                        )))
                     }
                     Err(SeedError::Other(e)) => return Err(e),
                 }

@@ -1,8 +1,8 @@
 //! The stress cases: scenes built in code at extreme scales, angles, sizes and radiances, with their analytic
 //! answers where they have one.
 
-use crate::lab::LabError;
 use super::{Case, Check, F32_FLOOR};
+use crate::lab::LabError;
 use crate::render::settings::{EnvSampling, LightSampling, Mode, SamplerKind, Settings, Strategy};
 use crate::scene::{self, Camera, Environment, Material, Mesh, PunctualLight, Quad, Scene, Sphere};
 use glam::{DVec3, Vec3};
@@ -249,7 +249,8 @@ fn env_from_texels(name: &str, w: u32, h: u32, texels: &[[f32; 3]]) -> Result<(E
     std::fs::create_dir_all(&dir).map_err(|e| LabError::Input(format!("{}: {e}", dir.display())))?;
     let path = dir.join(format!("{name}.exr"));
     let img = image::Rgb32FImage::from_fn(w, h, |x, y| image::Rgb(texels[(y * w + x) as usize]));
-    img.save_with_format(&path, image::ImageFormat::OpenExr).map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
+    img.save_with_format(&path, image::ImageFormat::OpenExr)
+        .map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
     let (map, warnings) = scene::envmap::load_envmap(&path).map_err(LabError::from)?;
     let _ = std::fs::remove_file(&path);
     Ok((Environment::Map { map: Arc::new(map), scale: 1.0, rotation: 0.0 }, warnings))

@@ -7,8 +7,8 @@ mod cases;
 
 pub use cases::{cases, polygon_irradiance};
 
-use crate::lab::LabError;
 use crate::gpu::GpuContext;
+use crate::lab::LabError;
 use crate::render::film::Film;
 use crate::render::settings::Settings;
 use crate::render::Renderer;
@@ -82,7 +82,11 @@ pub struct Outcome {
 
 /// Renders every case (on one thread per core; cases with equal pipelines share one build) and checks it. `filter` keeps the cases whose
 /// name contains it (twins are always run). `progress` is called after each case.
-pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Outcome)) -> Result<Vec<Outcome>, LabError> {
+pub fn run(
+    ctx: &GpuContext,
+    filter: Option<&str>,
+    mut progress: impl FnMut(&Outcome),
+) -> Result<Vec<Outcome>, LabError> {
     let all = cases()?;
     let wanted: Vec<&Case> = all
         .iter()
@@ -134,7 +138,11 @@ pub fn run(ctx: &GpuContext, filter: Option<&str>, mut progress: impl FnMut(&Out
             }
         }
         if outcomes.len() < wanted.len() {
-            return Err(LabError::Input(format!("the stress suite stopped after {} of {} cases", outcomes.len(), wanted.len())));
+            return Err(LabError::Input(format!(
+                "the stress suite stopped after {} of {} cases",
+                outcomes.len(),
+                wanted.len()
+            )));
         }
         Ok(outcomes)
     })

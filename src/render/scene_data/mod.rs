@@ -1,15 +1,14 @@
 //! SceneData: the scene flattened, on the CPU, into the tables the shaders read (geometry + BVH, shading
 //! data, light table, textures, environment distribution); `gpu_scene` uploads them.
 
-use crate::accel::{bvh, wide_bvh};
 use crate::accel::light_tree::GpuLightNode;
+use crate::accel::{bvh, wide_bvh};
 use crate::gpu::types::*;
 use crate::render::shading_data::{material_word, word_material, ShadingTable};
 use crate::scene::{Scene, TextureRef, Wrap};
 use glam::{Vec2, Vec3};
 
 mod light_table;
-
 
 /// Largest primitive count rendered without a BVH (`Features::flat`, `render::baked`).
 pub const FLAT_MAX_PRIMS: usize = 32;
@@ -371,8 +370,7 @@ impl SceneData {
 pub fn occluder_split(emits: &[bool], analytic_prims: usize, alpha: bool, on: bool) -> Option<Vec<usize>> {
     let occluders: Vec<usize> = (0..emits.len()).filter(|&i| !emits[i]).collect();
     let fits = !occluders.is_empty() && occluders.len() <= FLAT_MAX_PRIMS;
-    (on && fits && !alpha && analytic_prims == 0 && emits.len() > FLAT_MAX_PRIMS)
-        .then_some(occluders)
+    (on && fits && !alpha && analytic_prims == 0 && emits.len() > FLAT_MAX_PRIMS).then_some(occluders)
 }
 
 /// The choices `SceneData::build_options` makes.

@@ -172,8 +172,13 @@ pub const CORNELL_BOX_INDICES: [[u32; 3]; 12] = [
 /// inward), two white boxes (triangle meshes with the README's vertices and indices) and a one-sided area light at
 /// y = 1.98 emitting (17, 12, 4) downward.
 fn cornell_box() -> Scene {
-    let camera =
-        Camera { position: Vec3::new(0.0, 1.0, 6.8), forward: Vec3::NEG_Z, up: Vec3::Y, vfov: 19.5f32.to_radians(), window: Camera::FULL_WINDOW };
+    let camera = Camera {
+        position: Vec3::new(0.0, 1.0, 6.8),
+        forward: Vec3::NEG_Z,
+        up: Vec3::Y,
+        vfov: 19.5f32.to_radians(),
+        window: Camera::FULL_WINDOW,
+    };
     let mut b = Builder::new("cornell-box", camera);
     let white = b.material(Material::lambert("white", Vec3::new(0.725, 0.71, 0.68)));
     let red = b.material(Material::lambert("red", Vec3::new(0.63, 0.065, 0.05)));

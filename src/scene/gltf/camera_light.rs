@@ -35,7 +35,13 @@ impl Loader<'_> {
             self.notes.push(format!("{label}: unusable yfov {vfov} or degenerate node transform; skipped"));
             return Ok(None);
         }
-        Ok(Some(Camera { position: world.transform_point3(Vec3::ZERO), forward, up, vfov, window: Camera::FULL_WINDOW }))
+        Ok(Some(Camera {
+            position: world.transform_point3(Vec3::ZERO),
+            forward,
+            up,
+            vfov,
+            window: Camera::FULL_WINDOW,
+        }))
     }
 
     /// Adds a KHR_lights_punctual light placed by a node (lights shine down the node's -Z).
@@ -103,5 +109,11 @@ pub(super) fn frame_meshes(meshes: &[Mesh]) -> Camera {
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let vfov = 45f32.to_radians();
     let distance = radius / (vfov * 0.5).sin();
-    Camera { position: center + Vec3::Z * distance, forward: Vec3::NEG_Z, up: Vec3::Y, vfov, window: Camera::FULL_WINDOW }
+    Camera {
+        position: center + Vec3::Z * distance,
+        forward: Vec3::NEG_Z,
+        up: Vec3::Y,
+        vfov,
+        window: Camera::FULL_WINDOW,
+    }
 }

@@ -218,7 +218,8 @@ pub(super) fn load_buffers(root: &json::Root, bin: Option<&[u8]>, is_glb: bool, 
             return Err(format!("{what}: byteLength {declared} exceeds the limit of {MAX_GLTF_BYTES} bytes"));
         }
         let mut data = match (&buffer.uri, bin) {
-            (Some(uri), _) => fetch_uri(uris, uri, |p| read_prefix(p, declared).map_err(|e| e.to_string())).map_err(|m| format!("{what}: {m}"))?,
+            (Some(uri), _) => fetch_uri(uris, uri, |p| read_prefix(p, declared).map_err(|e| e.to_string()))
+                .map_err(|m| format!("{what}: {m}"))?,
             (None, Some(bin)) if i == 0 => bin.to_vec(),
             (None, None) if i == 0 && is_glb => {
                 return Err(format!("{what} has no uri, and the GLB file has no BIN chunk to hold its data"))

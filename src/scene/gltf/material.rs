@@ -151,7 +151,8 @@ impl Loader<'_> {
         let what = format!("image {index} ({})", image_name(root, index));
         let bytes = match (&image.uri, image.buffer_view) {
             (Some(uri), _) => fetch_uri(self.uris(), uri, |p| {
-                crate::io::input_file::read_bounded(p, crate::io::input_file::MAX_IMAGE_BYTES).map_err(|e| e.to_string())
+                crate::io::input_file::read_bounded(p, crate::io::input_file::MAX_IMAGE_BYTES)
+                    .map_err(|e| e.to_string())
             }),
             (None, Some(view)) => self.view(view.value()).map(|(bytes, _)| bytes.to_vec()),
             (None, None) => Err("has neither a uri nor a bufferView".into()),

@@ -61,7 +61,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
 }
 
 fn load_inner(path: &Path, options: &LoadOptions) -> Res<Scene> {
-    let bytes = crate::io::input_file::read_bounded(path, crate::io::input_file::MAX_GLTF_BYTES).map_err(|e| e.to_string())?;
+    let bytes =
+        crate::io::input_file::read_bounded(path, crate::io::input_file::MAX_GLTF_BYTES).map_err(|e| e.to_string())?;
     let (json_bytes, bin) = split_container(path, &bytes)?;
     let is_glb = bytes.starts_with(b"glTF");
     let root = parse_json(json_bytes)?;

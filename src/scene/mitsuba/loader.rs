@@ -745,7 +745,8 @@ impl Loader {
         let position = to_world.transform_point3(DVec3::ZERO).as_vec3();
         let forward = to_world.transform_vector3(DVec3::Z).normalize().as_vec3();
         let up = to_world.transform_vector3(DVec3::Y).normalize().as_vec3();
-        self.b.scene.camera = Camera { position, forward, up, vfov: (2.0 * vhalf.atan()) as f32, window: Camera::FULL_WINDOW };
+        self.b.scene.camera =
+            Camera { position, forward, up, vfov: (2.0 * vhalf.atan()) as f32, window: Camera::FULL_WINDOW };
         self.b.scene.film_size = Some([w, h]);
         if let Some(c) = crop_at {
             let [cw, ch] = [crop_size[0].unwrap_or(w), crop_size[1].unwrap_or(h)];

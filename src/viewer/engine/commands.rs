@@ -1,13 +1,13 @@
 //! How each [`Command`] from the UI changes the engine: settings, comparison, camera, display options,
 //! scene, environment and reference loading, EXR saving, and the test hook that loses the device.
 
-use crate::viewer::ViewerError;
 use super::display;
 use super::side::SideState;
 use super::{scene_centre, Command, Engine};
 use crate::render::settings::Settings;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{self, Environment, LoadOptions, Scene};
+use crate::viewer::ViewerError;
 use std::sync::Arc;
 
 impl Engine {

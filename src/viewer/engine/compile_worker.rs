@@ -2,7 +2,6 @@
 //! second device first, see [`compile_worker`]), and the engine's side of it: which pipelines to ask for,
 //! in what order, taking the built ones in, and choosing the one a side renders with.
 
-use crate::viewer::ViewerError;
 use super::side::SideState;
 use super::{Engine, PipelineState};
 use crate::gpu::{GpuContext, PipelineMemo};
@@ -11,6 +10,7 @@ use crate::render::settings::{Settings, Strategy};
 use crate::render::Renderer;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{Camera, Scene};
+use crate::viewer::ViewerError;
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};

@@ -12,7 +12,6 @@
 //! (device loss and recreation), `commands` (how each command changes the engine); this file holds the
 //! tuning constants, the engine's state and its loop.
 
-use crate::viewer::ViewerError;
 use super::display::{self, DisplayPass, ImageStats};
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
@@ -22,6 +21,7 @@ use crate::render::settings::Settings;
 use crate::render::Renderer;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{Camera, Scene};
+use crate::viewer::ViewerError;
 use compile_worker::{CompileJob, Wanted};
 use side::SideState;
 use std::collections::{HashMap, HashSet};

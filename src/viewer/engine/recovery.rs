@@ -1,13 +1,13 @@
 //! Device loss and GPU errors: the callbacks that report them, and recreating the device and everything
 //! on it (scene, sides, display pass, compile worker, timer) so the render restarts instead of stopping.
 
-use crate::viewer::ViewerError;
 use super::display::DisplayPass;
 use super::side::SideState;
 use super::Engine;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
+use crate::viewer::ViewerError;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 

@@ -1,13 +1,13 @@
 //! One side's render state (the full-resolution and the preview renderer, cost estimates, restarts) and
 //! the band planner that sizes each dispatch to the frame budget.
 
-use crate::viewer::ViewerError;
 use super::{PipelineState, PREVIEW_SCALE};
 use crate::gpu::GpuContext;
 use crate::render::gpu_scene::GpuScene;
 use crate::render::settings::Settings;
 use crate::render::Renderer;
 use crate::scene::Camera;
+use crate::viewer::ViewerError;
 use std::time::Instant;
 
 /// Per-side render state.

@@ -29,7 +29,9 @@ pub(super) fn pixel_bounds(p: &Params, w: u32, h: u32) -> Result<(Option<[u32; 4
             return Err(p.error(format!("\"cropwindow\" has {} values; expected 4", cr.len())));
         }
         if bounds != full {
-            warning = Some("Film: both \"pixelbounds\" and \"cropwindow\" given; the crop window is used (as pbrt-v4 does)".into());
+            warning = Some(
+                "Film: both \"pixelbounds\" and \"cropwindow\" given; the crop window is used (as pbrt-v4 does)".into(),
+            );
         }
         let unit = |v: f64| v.clamp(0.0, 1.0);
         let (cx0, cx1) = (unit(cr[0].min(cr[1])), unit(cr[0].max(cr[1])));
