@@ -100,30 +100,14 @@ fn every_light_kind_is_its_section_one_tag_and_one_case_per_dispatcher() {
         assert_eq!(count(&all, &format!("LIGHT_{k}")), ops.len(), "LIGHT_{k} is named outside the light dispatchers");
     }
     assert_eq!(count(&all, ".kind"), ops.len(), "something besides the dispatchers reads a light's kind");
-    // Rust: the tag is defined in gpu/types.rs, turned into table entries in render/scene_data/light_table.rs (and counted in
-    // render/scene_data/mod.rs) and into HAS_*
-    // flags in render/features.rs, and named in no other file of src/.
-    let mut files = Vec::new();
-    let mut stack = vec![dir.join("src")];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                files.push(p);
-            }
-        }
-    }
-    for f in files {
-        let text = std::fs::read_to_string(&f).unwrap();
-        let name = f.strip_prefix(dir.join("src")).unwrap().to_str().unwrap().replace('\\', "/");
+    // Rust: the tag is defined in gpu/types.rs, turned into table entries in render/scene_data/light_table.rs (and
+    // counted in render/scene_data/mod.rs) and into HAS_* flags in render/features.rs, and named in no other file.
+    for (name, text) in rust_sources(dir) {
         if kinds.iter().any(|k| text.contains(&format!("LIGHT_{k}"))) {
             assert!(
                 ["gpu/types.rs", "render/scene_data/mod.rs", "render/scene_data/light_table.rs", "render/features.rs"]
                     .contains(&name.as_str()),
-                "{} names a light kind: adding one would have to touch it too",
-                f.display()
+                "src/{name} names a light kind: adding one would have to touch it too"
             );
         }
     }
@@ -209,21 +193,7 @@ fn every_material_kind_is_its_file_and_its_registry_entry() {
     );
     // Rust: the tags, their overrides and the kinds' words are named in render/materials.rs alone; `MaterialKind`
     // (the scene description) in scene/ (its importers) and the registry's `pack_*`.
-    let mut files = Vec::new();
-    let mut stack = vec![dir.join("src")];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                files.push(p);
-            }
-        }
-    }
-    for f in files {
-        let text = std::fs::read_to_string(&f).unwrap();
-        let name = f.strip_prefix(dir.join("src")).unwrap().to_str().unwrap().replace('\\', "/");
+    for (name, text) in rust_sources(dir) {
         if name == "render/materials.rs" {
             continue;
         }
@@ -320,4 +290,23 @@ fn a_damaged_pipeline_cache_is_a_note_and_is_rewritten_whole() {
 
 fn common_gpu() -> mislab::gpu::GpuContext {
     mislab::gpu::GpuContext::new().unwrap_or_else(|e| panic!("this test needs a Vulkan adapter and found none ({e})"))
+}
+
+/// Every `.rs` file of `src/`: its path below `src/` (with `/`) and its text.
+fn rust_sources(dir: &std::path::Path) -> Vec<(String, String)> {
+    let src = dir.join("src");
+    let mut files = Vec::new();
+    let mut stack = vec![src.clone()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let name = p.strip_prefix(&src).unwrap().to_str().unwrap().replace('\\', "/");
+                files.push((name, std::fs::read_to_string(&p).unwrap()));
+            }
+        }
+    }
+    files
 }
