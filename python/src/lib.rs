@@ -23,7 +23,7 @@ fn py_err(e: ApiError) -> PyErr {
     match e {
         ApiError::Settings(_) => PyValueError::new_err(message),
         ApiError::NotFound(_) => PyFileNotFoundError::new_err(message),
-        ApiError::Scene(_) => SceneError::new_err(message),
+        ApiError::Scene(_) | ApiError::Upload(_) => SceneError::new_err(message),
         _ => PyRuntimeError::new_err(message),
     }
 }

@@ -19,7 +19,7 @@ pub enum ApiError {
     /// A scene file that cannot be loaded (the message names the file, and the line for text formats).
     #[error(transparent)]
     Scene(#[from] LoadError),
-    /// A scene that loaded but does not fit the device.
+    /// A scene that loaded but does not fit the device (Python: `mislab.SceneError`, as a file that cannot load).
     #[error("{0}")]
     Upload(String),
     /// No usable device, or the device failed.
