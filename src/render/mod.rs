@@ -20,6 +20,7 @@ pub mod renderer;
 pub mod samplers;
 pub mod scene_data;
 pub mod settings;
+pub mod shader_prune;
 pub mod shaders;
 pub mod shading_data;
 pub mod tile_order;

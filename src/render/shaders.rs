@@ -2,6 +2,7 @@
 //! run time); an entry point is an ordered list of files concatenated into one module.
 
 use crate::gpu::PipelineStore;
+use crate::render::shader_prune;
 
 /// Every WGSL file but the materials', by name, embedded at compile time (each material kind's file is embedded by
 /// its entry in `crate::render::materials::MATERIALS`).
@@ -136,8 +137,9 @@ pub fn with_32_byte_loads(source: &str) -> Option<String> {
     changed.then_some(out)
 }
 
-/// Builds a compute pipeline from a composed module (validated by naga first so errors are readable), through the
-/// driver's on-disk pipeline cache where there is one (`store`; saved as soon as the pipeline is built).
+/// Builds a compute pipeline from a composed module (validated by naga first so errors are readable), specialised
+/// to `constants` and pruned before the driver sees it (`shader_prune`), through the driver's on-disk pipeline
+/// cache where there is one (`store`; saved as soon as the pipeline is built).
 pub fn compute_pipeline(
     device: &wgpu::Device,
     store: Option<&PipelineStore>,
@@ -148,7 +150,16 @@ pub fn compute_pipeline(
     layout: Option<&wgpu::PipelineLayout>,
 ) -> Result<wgpu::ComputePipeline, String> {
     let source = for_device(source, device.features());
-    validate(&source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
+    let parsed = validate(&source).map_err(|e| format!("shader '{label}' failed to validate:\n{e}"))?;
+    // The driver gets the module specialised and pruned (`shader_prune`): start-up is its compilation. Should the
+    // pruner ever fail on a valid module, the driver still gets the module as written, with its overrides.
+    let pruned = shader_prune::specialized_wgsl(&parsed, entry, constants)
+        .map_err(|e| eprintln!("warning: shader '{label}' compiled unpruned (slower start-up): {e}"))
+        .ok();
+    let (source, constants): (std::borrow::Cow<str>, &[(&str, f64)]) = match pruned {
+        Some(p) => (p.into(), &[]),
+        None => (source, constants),
+    };
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source),
