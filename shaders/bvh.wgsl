@@ -196,12 +196,12 @@ fn intersect_prim(r: TraceRay, prim: u32, t_max: f32) -> vec4<f32> {
         }
         case PRIM_SPHERE: {
             if (!HAS_SPHERES) { return vec4<f32>(0.0); }
-            let s = spheres[i];
+            let s = load_spheres(i);
             return intersect_sphere(r.o, r.d, s.center, s.radius, t_max);
         }
         case PRIM_QUAD: {
             if (!HAS_QUADS) { return vec4<f32>(0.0); }
-            return intersect_quad(r.o, r.d, quads[i], t_max);
+            return intersect_quad(r.o, r.d, load_quads(i), t_max);
         }
         default: {
             return vec4<f32>(0.0);
@@ -224,16 +224,16 @@ fn tri_vertex_words(k: u32) -> vec4<u32> {
         let n0 = tri_verts_len();
         if k >= n0 {
             let k1 = k - n0;
-            let n1 = arrayLength(&tri_verts_hi);
+            let n1 = len_tri_verts_hi();
             if k1 < n1 {
-                return tri_verts_hi[k1];
+                return load_tri_verts_hi(k1);
             }
             let k2 = k1 - n1;
-            let n2 = arrayLength(&tri_verts_hi2);
+            let n2 = len_tri_verts_hi2();
             if k2 < n2 {
-                return tri_verts_hi2[k2];
+                return load_tri_verts_hi2(k2);
             }
-            return tri_verts_hi3[k2 - n2];
+            return load_tri_verts_hi3(k2 - n2);
         }
     }
     return tri_verts_words(k);
@@ -321,7 +321,7 @@ fn bvh_leaf_test(r: TraceRay, j: u32, t: f32, skip: u32) -> LeafHit {
         }
     } else {
         // A triangle-only scene uploads no references (src/render/scene_data.rs IDENTITY_PRIM_REFS): INVALID = j.
-        prim = prim_refs[min(j, arrayLength(&prim_refs) - 1u)];
+        prim = load_prim_refs(min(j, len_prim_refs() - 1u));
         if prim == INVALID {
             prim = j;
         }
@@ -379,12 +379,12 @@ fn bvh_traverse(o: vec3<f32>, d: vec3<f32>, t_max: f32, any_hit: bool, skip: u32
     var sp = 0u;
     var cur = 0u;        // the next interior node to visit, a leaf waiting behind `leaf`, or INVALID: pop
     var leaf = INVALID;  // the postponed leaf: its next primitive and how many follow
-    let max_steps = arrayLength(&bvh_nodes) + 1u;
+    let max_steps = len_bvh_nodes() + 1u;
     for (var round = 0u; round < max_steps && (cur != INVALID || leaf != INVALID || sp > 0u); round++) {
         for (var step = 0u; step < 2u * max_steps && (bvh_is_interior(cur) || (cur == INVALID && sp > 0u)); step++) {
             var next = INVALID;
             if cur != INVALID {
-                let node = bvh_nodes[cur];
+                let node = load_bvh_nodes(cur);
                 let l_valid = node.l_count > 0u || node.l_first != INVALID;
                 let r_valid = node.r_count > 0u || node.r_first != INVALID;
                 let tl = select(F32_MAX, ray_box_entry(r, node.lmin, node.lmax, hit.t), l_valid);

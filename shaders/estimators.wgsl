@@ -104,10 +104,11 @@ fn stop_box_entry(prim: u32, o: vec3<f32>, d: vec3<f32>) -> f32 {
         return F32_MAX;
     }
     let li = scene_tri_light(prim & PRIM_INDEX_MASK);
-    if li == INVALID || lights[li].shadow_box == 0u {
+    if li == INVALID || load_lights(li).shadow_box == 0u {
         return F32_MAX;
     }
-    let s = box_slabs(lights[li].position, lights[li].direction, o, d);
+    let lamp = load_lights(li);
+    let s = box_slabs(lamp.position, lamp.direction, o, d);
     let entry = max(max(s.near.x, s.near.y), s.near.z);
     if !(entry > 0.0) {
         return F32_MAX;

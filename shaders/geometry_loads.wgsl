@@ -5,25 +5,25 @@
 
 /// Vertex k of `tri_verts` as words (position bits, corner record index).
 fn tri_verts_words(k: u32) -> vec4<u32> {
-    return tri_verts[k];
+    return load_tri_verts(k);
 }
 
 /// How many vertices `tri_verts` holds (where the split path's further bindings begin).
 fn tri_verts_len() -> u32 {
-    return arrayLength(&tri_verts);
+    return len_tri_verts();
 }
 
 /// Triangle i's vertices, all three in `tri_verts`: three loads.
 fn tri_words(i: u32) -> TriWords {
-    return TriWords(tri_verts[3u * i], tri_verts[3u * i + 1u], tri_verts[3u * i + 2u]);
+    return TriWords(load_tri_verts(3u * i), load_tri_verts(3u * i + 1u), load_tri_verts(3u * i + 2u));
 }
 
 /// Wide BVH node i: five loads.
 fn wide_node(i: u32) -> WideNode {
-    return wide_nodes[i];
+    return load_wide_nodes(i);
 }
 
 /// How many wide nodes the binding holds.
 fn wide_node_count() -> u32 {
-    return arrayLength(&wide_nodes);
+    return len_wide_nodes();
 }

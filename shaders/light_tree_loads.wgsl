@@ -4,5 +4,5 @@
 
 /// Light-tree node i.
 fn light_node(i: u32) -> LightNode {
-    return light_tree[i];
+    return load_light_tree(i);
 }

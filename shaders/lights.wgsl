@@ -82,7 +82,7 @@ fn alias_sample(base: u32, n: u32, u: f32, table_is_env: bool) -> u32 {
     let i = min(u32(x), n - 1u);
     let r = x - f32(i);
     var e: AliasEntry;
-    if (table_is_env) { e = env_alias[base + i]; } else { e = light_alias[base + i]; }
+    if (table_is_env) { e = load_env_alias(base + i); } else { e = load_light_alias(base + i); }
     return select(e.alias_index, i, r < e.prob);
 }
 
@@ -96,7 +96,7 @@ struct AliasPick {
 fn alias_sample2(base: u32, n: u32, u_col: f32, u_coin: f32, table_is_env: bool) -> AliasPick {
     let i = min(u32(u_col * f32(n)), n - 1u);
     var e: AliasEntry;
-    if (table_is_env) { e = env_alias[base + i]; } else { e = light_alias[base + i]; }
+    if (table_is_env) { e = load_env_alias(base + i); } else { e = load_light_alias(base + i); }
     if (u_coin < e.prob) { return AliasPick(i, min(u_coin / e.prob, ONE_MINUS_EPSILON)); }
     return AliasPick(e.alias_index, min((u_coin - e.prob) / (1.0 - e.prob), ONE_MINUS_EPSILON));
 }
@@ -648,7 +648,7 @@ fn env_cosine(n: vec3<f32>) -> bool {
 fn env_radiance(w: vec3<f32>) -> vec3<f32> {
     if (ENV_KIND == 0u) { return vec3<f32>(0.0); }
     if (ENV_KIND == 1u || (ENV_KIND == 3u && params.env_width == 0u)) { return params.env_constant * params.env_scale; }
-    return env_texels[env_texel_index(env_direction_to_uv(w))].xyz * params.env_scale;
+    return load_env_texels(env_texel_index(env_direction_to_uv(w))).xyz * params.env_scale;
 }
 
 /// pdf (solid angle) of `env_sample(·, p, n)` producing w: max(w·n, 0)/π (a constant map, cosine about n; guided:
@@ -665,7 +665,7 @@ fn env_pdf(w: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
     }
     if (env_uniform()) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
-    let density_uv = env_texels[env_texel_index(uv)].w;
+    let density_uv = load_env_texels(env_texel_index(uv)).w;
     let sin_theta = length(w.xz);
     return density_uv / (2.0 * PI * PI * max(sin_theta, 1e-7));
 }
@@ -709,7 +709,7 @@ fn env_sample(u: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     let y = pick.index / params.env_width;
     let uv = vec2<f32>((f32(x) + u.x) / f32(params.env_width), (f32(y) + pick.u) / f32(params.env_height));
     let wi = env_uv_to_direction(uv);
-    let texel = env_texels[pick.index];
+    let texel = load_env_texels(pick.index);
     let pdf = texel.w / (2.0 * PI * PI * max(length(wi.xz), 1e-7));
     if (!(pdf > 0.0)) { return no_light_sample(); }
     return LightSample(wi, F32_MAX, texel.xyz * params.env_scale, pdf, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);

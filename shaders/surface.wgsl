@@ -109,8 +109,8 @@ fn wrap_coord(x: i32, n: i32, mode: u32) -> i32 {
 
 /// Word `i` of the texture at `offset` (TEXEL_HI: in the second texel binding).
 fn texel_word(offset: u32, i: u32) -> u32 {
-    if (HAS_TEXEL_SPLIT && (offset & TEXEL_HI) != 0u) { return tex_texels_hi[(offset & ~TEXEL_HI) + i]; }
-    return tex_texels[offset + i];
+    if (HAS_TEXEL_SPLIT && (offset & TEXEL_HI) != 0u) { return load_tex_texels_hi((offset & ~TEXEL_HI) + i); }
+    return load_tex_texels(offset + i);
 }
 
 fn texel(info: TextureInfo, x: i32, y: i32) -> vec4<f32> {
@@ -137,7 +137,7 @@ fn checkerboard_lookup(info: TextureInfo, st: vec2<f32>) -> vec4<f32> {
 /// Bilinear (or nearest) lookup with the texture's wrap modes, after the 2×3 uv transform; or a procedural
 /// texture at the transformed uv.
 fn texture_lookup(tex: u32, xf0: vec4<f32>, xf1: vec4<f32>, uv_in: vec2<f32>) -> vec4<f32> {
-    let info = tex_info[tex];
+    let info = load_tex_info(tex);
     let uv = vec2<f32>(dot(xf0.xyz, vec3<f32>(uv_in, 1.0)), dot(xf1.xyz, vec3<f32>(uv_in, 1.0)));
     if (is_nonfinite(uv.x) || is_nonfinite(uv.y)) { return vec4<f32>(0.0); }
     if (HAS_CHECKERBOARD && info.tex_kind == TEX_CHECKERBOARD) { return checkerboard_lookup(info, uv); }

@@ -117,7 +117,7 @@ fn probe_light_normal(i: u32, y: vec3<f32>) -> vec3<f32> {
         return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
     }
     if (l.kind == LIGHT_QUAD) { let q = quads[l.prim]; return normalize(cross(q.edge_u, q.edge_v)); }
-    if (l.kind == LIGHT_SPHERE) { return normalize(y - spheres[l.prim].center); }
+    if (l.kind == LIGHT_SPHERE) { return normalize(y - load_spheres(l.prim).center); }
     return vec3<f32>(0.0, 0.0, 1.0);
 }
 

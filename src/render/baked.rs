@@ -216,13 +216,13 @@ pub fn scene_data_source(data: &SceneData) -> Option<(String, String)> {
     let vertex = wgsl_members("ShadingVertex");
     // Indexed by vertex here (the corners above are `tri_shading`'s); the buffer holds `stride` records per vertex.
     let stride = data.shading_record_stride();
-    let uv = if stride == 2 { "bitcast<vec2<f32>>(shading_verts[2u * i + 1u])" } else { "vec2<f32>(0.0)" };
-    let read = format!("ShadingVertex(shading_verts[{stride}u * i].x, shading_verts[{stride}u * i].y, {uv})");
+    let uv = if stride == 2 { "bitcast<vec2<f32>>(load_shading_verts(2u * i + 1u))" } else { "vec2<f32>(0.0)" };
+    let read = format!("ShadingVertex(load_shading_verts({stride}u * i).x, load_shading_verts({stride}u * i).y, {uv})");
     out += &accessor("scene_shading_vertex", "ShadingVertex", &vertex, &data.shading_verts, &read);
-    out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "spheres[i]");
-    out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "quads[i]");
-    out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
-    out += &accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights, "lights[i]");
+    out += &accessor("scene_sphere", "Sphere", &wgsl_members("Sphere"), &data.spheres, "load_spheres(i)");
+    out += &accessor("scene_quad", "Quad", &wgsl_members("Quad"), &data.quads, "load_quads(i)");
+    out += &accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "load_materials(i)");
+    out += &accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights, "load_lights(i)");
     // (No BVH is walked, but the wide traversal that is compiled out still names the root functions.)
     Some((out, baked_traverse_source(data, 0..data.tri_shading.len(), true) + BUFFER_ROOT))
 }
@@ -236,13 +236,14 @@ pub fn occluder_scene_data_source(data: &SceneData) -> Option<String> {
     baked_occluders(data).then_some(())?;
     let mut out = crate::render::shaders::file("scene_data.wgsl").to_string();
     if data.materials.len() <= LITERAL_TABLE_MAX {
-        let f = accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "materials[i]");
-        out = out.replace("fn scene_material(i: u32) -> Material { return materials[i]; }\n", &f);
+        let f = accessor("scene_material", "Material", &wgsl_members("Material"), &data.materials, "load_materials(i)");
+        out = out.replace("fn scene_material(i: u32) -> Material { return load_materials(i); }\n", &f);
     }
     let n = data.selectable_lights();
     if n <= LITERAL_TABLE_MAX {
-        let f = literal_accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights[..n], "lights[i]", true);
-        out = out.replace("fn scene_light(i: u32) -> Light { return lights[i]; }\n", &f);
+        let f =
+            literal_accessor("scene_light", "Light", &wgsl_members("Light"), &data.lights[..n], "load_lights(i)", true);
+        out = out.replace("fn scene_light(i: u32) -> Light { return load_lights(i); }\n", &f);
     }
     // The occluders' positions, corners (record indices, as the buffer's w words hold them) and shading records:
     // what shading a hit on one reads.
@@ -427,7 +428,7 @@ pub fn occluder_light_tree_source(data: &SceneData) -> Option<String> {
         return None;
     }
     let members = ["vec4<u32>"; 4].map(String::from);
-    Some(accessor("light_node", "LightNode", &members, &data.light_tree, "light_tree[i]"))
+    Some(accessor("light_node", "LightNode", &members, &data.light_tree, "load_light_tree(i)"))
 }
 
 /// The generated `baked_geometry.wgsl` of a scene with baked occluders (`SceneData::occluders`): the tests of

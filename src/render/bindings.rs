@@ -307,12 +307,28 @@ pub fn wgsl_declaration(b: &Binding) -> String {
     format!("{note}@group({}) @binding({}) {var} {}: {};\n", b.group, b.binding, b.name, b.wgsl_type)
 }
 
+/// The element type of an `array<T>` binding.
+pub fn element_type(b: &Binding) -> &'static str {
+    b.wgsl_type.strip_prefix("array<").and_then(|t| t.strip_suffix('>')).unwrap_or(b.wgsl_type)
+}
+
+/// How shaders read scene binding `b`: `load_<name>(i)` (element i) and `len_<name>()` (its element count), never
+/// the binding itself, so the same code runs on the packed layout (`render::packed_scene`), where these read the
+/// one buffer that holds every table.
+pub fn scene_accessors(b: &Binding) -> String {
+    let (name, ty) = (b.name, element_type(b));
+    format!(
+        "fn load_{name}(i: u32) -> {ty} {{ return {name}[i]; }}\nfn len_{name}() -> u32 {{ return arrayLength(&{name}); }}\n"
+    )
+}
+
 /// `geometry_bindings.wgsl`: the geometry bindings (group 0: 0–4, 14 and 17), for BVH traversal.
 pub fn geometry_wgsl() -> String {
     let mut s =
         String::from("// geometry_bindings.wgsl — generated from src/render/bindings.rs: the scene's geometry.\n\n");
     for b in geometry() {
         s += &wgsl_declaration(&b.binding);
+        s += &scene_accessors(&b.binding);
     }
     s
 }
@@ -325,6 +341,7 @@ pub fn shading_wgsl() -> String {
     );
     for b in shading() {
         s += &wgsl_declaration(&b.binding);
+        s += &scene_accessors(&b.binding);
     }
     s += "\n";
     for b in &FRAME {

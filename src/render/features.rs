@@ -76,6 +76,9 @@ pub struct Features {
     /// For flat scenes, a hash of the scene data baked into its pipelines' source (src/render/baked.rs), so that a
     /// pipeline cache never hands one scene's baked pipeline to another; 0 otherwise.
     pub baked: u64,
+    /// The scene's tables are bound as one packed buffer (`render::packed_scene`): not a code path of the
+    /// renderer but its module's reads, so pipelines of the two layouts never mix.
+    pub packed_scene: bool,
 }
 
 impl Features {
@@ -107,6 +110,7 @@ impl Features {
             occluders: GENERIC_OCCLUDERS,
             baked_root: false,
             baked: 0,
+            packed_scene: false,
         }
     }
 
@@ -151,6 +155,7 @@ impl Features {
                 src.hash(&mut h);
                 h.finish() | 1
             }),
+            packed_scene: false,
         }
     }
 

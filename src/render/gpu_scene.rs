@@ -4,13 +4,16 @@
 use crate::gpu::types::TEXEL_HI;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
+use crate::render::packed_scene::{self, SceneLayout};
 use crate::render::scene_data::SceneData;
 
 /// The scene's buffers on a device, bound as group 0 of the render pipeline.
 pub struct GpuScene {
     /// The CPU copy (statistics, light counts, environment parameters).
     pub data: SceneData,
-    /// Group-0 buffers in binding order (`bindings::SCENE`).
+    /// How the tables are bound: separate buffers, or one packed buffer where the device binds too few.
+    pub layout: SceneLayout,
+    /// Group-0 buffers in binding order (`bindings::SCENE`), or the one packed buffer.
     pub buffers: Vec<wgpu::Buffer>,
 }
 
@@ -118,8 +121,12 @@ pub fn fit_to_binding_limit(data: &mut SceneData, limit: u64) -> Result<(), GpuE
 impl GpuScene {
     /// Uploads a flattened scene, refusing (with the buffer, its size and the limit named) anything
     /// larger than the device's storage-buffer binding limit; texels may take two bindings, vertices four
-    /// (`split_texels`, `split_vertices`).
+    /// (`split_texels`, `split_vertices`). On a device that binds fewer storage buffers per shader stage than the
+    /// scene and the frame together (WebGPU's guaranteed 8), the tables are packed into one buffer.
     pub fn upload(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, GpuError> {
+        if (ctx.limits().max_storage_buffers_per_shader_stage as usize) < storage_bindings_needed() {
+            return Self::upload_packed(ctx, data);
+        }
         Self::upload_with_limit(ctx, data, u64::MAX)
     }
 
@@ -135,6 +142,46 @@ impl GpuScene {
                 ctx.storage_buffer_bytes(b.binding.name, &bytes, b.binding.element_size)
             })
             .collect();
-        Ok(GpuScene { data, buffers })
+        Ok(GpuScene { data, layout: SceneLayout::Separate, buffers })
     }
+
+    /// Uploads with every table in one buffer (`packed_scene`), whatever the device offers: the web's layout, which
+    /// tests check natively against the separate one.
+    pub fn upload_packed(ctx: &GpuContext, data: SceneData) -> Result<GpuScene, GpuError> {
+        let words = packed_scene::pack(&data);
+        let (bytes, limit) = (4 * words.len() as u64, ctx.max_storage_binding());
+        if bytes > limit {
+            return Err(GpuError::SceneTooLarge { buffer: packed_scene::PACKED.label, bytes, limit });
+        }
+        let buffer = ctx.storage_buffer("scene_words", &words, wgpu::BufferUsages::empty());
+        Ok(GpuScene { data, layout: SceneLayout::Packed, buffers: vec![buffer] })
+    }
+
+    /// The bindings of group 0 for this layout.
+    pub fn bindings(&self) -> Vec<&'static bindings::Binding> {
+        match self.layout {
+            SceneLayout::Separate => bindings::SCENE.iter().map(|b| &b.binding).collect(),
+            SceneLayout::Packed => vec![&packed_scene::PACKED],
+        }
+    }
+
+    /// Group 0's bind-group layout entries.
+    pub fn layout_entries(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
+        self.bindings().into_iter().map(bindings::layout_entry).collect()
+    }
+
+    /// Group 0's bind-group entries: the buffers at their bindings.
+    pub fn bind_group_entries(&self) -> Vec<wgpu::BindGroupEntry<'_>> {
+        let bindings = self.bindings().into_iter().map(|b| b.binding);
+        bindings
+            .zip(&self.buffers)
+            .map(|(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+            .collect()
+    }
+}
+
+/// Storage buffers one render kernel binds on the separate layout: the scene's and the frame's.
+pub fn storage_bindings_needed() -> usize {
+    let frame = bindings::FRAME.iter().filter(|b| b.access != bindings::Access::Uniform).count();
+    bindings::SCENE.len() + frame
 }

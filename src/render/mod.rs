@@ -12,6 +12,7 @@ pub mod film;
 pub mod gpu_scene;
 pub mod lights;
 pub mod materials;
+pub mod packed_scene;
 pub mod pipeline_cache;
 pub mod pixel_filter;
 pub mod reachability;

@@ -10,6 +10,7 @@ pub use crate::render::error::{InvalidSettings, RenderError};
 use crate::render::features::{Features, PipelineKey};
 use crate::render::film::Film;
 use crate::render::gpu_scene::GpuScene;
+use crate::render::packed_scene::{for_layout, SceneLayout};
 use crate::render::pipeline_cache::PipelineCache;
 use crate::render::pixel_filter;
 use crate::render::render_module::{render_source, render_source_for};
@@ -130,10 +131,9 @@ impl Renderer {
     ) -> Result<Renderer, RenderError> {
         settings.validate().map_err(RenderError::Settings)?;
         let device = ctx.device.clone();
-        let scene_entries: Vec<_> = bindings::SCENE.iter().map(|b| bindings::layout_entry(&b.binding)).collect();
         let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
-            entries: &scene_entries,
+            entries: &scene.layout_entries(),
         });
         let frame_entries: Vec<_> = bindings::FRAME.iter().map(bindings::layout_entry).collect();
         let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -145,16 +145,10 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout0), Some(&layout1)],
             immediate_size: 0,
         });
-        let entries: Vec<wgpu::BindGroupEntry> = scene
-            .buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-            .collect();
         let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout0,
-            entries: &entries,
+            entries: &scene.bind_group_entries(),
         });
         let pixels = settings.width as u64 * settings.height as u64;
         let accum_bytes = pixels * std::mem::size_of::<GpuAccum>() as u64;
@@ -218,7 +212,7 @@ impl Renderer {
             queue: ctx.queue.clone(),
             pipeline_layout,
             pipelines: PipelineCache::on_device(&ctx.pipelines),
-            features: Features::of(d),
+            features: Features { packed_scene: scene.layout == SceneLayout::Packed, ..Features::of(d) },
             specialize: true,
             warmed: None,
             scene_group,
@@ -245,8 +239,8 @@ impl Renderer {
             occluders: d.occluders,
             origin: d.origin,
             offset_scale: d.offset_scale,
-            source: render_source_for(d),
-            shared_source: render_source(),
+            source: for_layout(render_source_for(d), scene.layout).map_err(RenderError::Pipeline)?,
+            shared_source: for_layout(render_source(), scene.layout).map_err(RenderError::Pipeline)?,
             guide_grid,
             guide_cdf,
             guide_counts,
@@ -286,7 +280,9 @@ impl Renderer {
         if self.specialize {
             PipelineKey::specialized(self.features, &self.settings)
         } else {
-            PipelineKey::generic()
+            let mut key = PipelineKey::generic();
+            key.features.packed_scene = self.features.packed_scene;
+            key
         }
     }
 

@@ -106,7 +106,8 @@ pub fn for_device(source: &str, features: wgpu::Features) -> std::borrow::Cow<'_
         // (naga 30 takes subgroup builtins without WGSL's `enable subgroups;`, which it rejects as unimplemented.)
         out = out.replace(BVH_VOTE_FALLBACK, "return subgroupAll(b);").into();
     }
-    if features.contains(wgpu::Features::SHADER_INT64) {
+    // The packed scene layout reads every table as words (`packed_scene`): its loads have no 32-byte twin.
+    if features.contains(wgpu::Features::SHADER_INT64) && !crate::render::packed_scene::is_packed(&out) {
         out = with_32_byte_loads(&out).map_or(out, Into::into);
     }
     out
@@ -131,6 +132,8 @@ pub fn with_32_byte_loads(source: &str) -> Option<String> {
         for b in bindings::all().filter(|b| bindings::READ_32_BYTES_AT_A_TIME.contains(&(b.name, portable))) {
             let wide = bindings::Binding { wgsl_type: bindings::WGSL_32_BYTE_ELEMENTS, ..b };
             out = out.replace(&bindings::wgsl_declaration(&b), &bindings::wgsl_declaration(&wide));
+            // Only the twin reads the redeclared binding: the portable accessors go with the portable file.
+            out = out.replace(&bindings::scene_accessors(&b), "");
         }
         changed = true;
     }

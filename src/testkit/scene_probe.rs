@@ -129,18 +129,13 @@ impl ScenePipelines {
         ctx.queue.write_buffer(&self.guide_cdf, 0, bytemuck::cast_slice(cdf));
     }
 
-    /// Binds an uploaded scene as group 0.
+    /// Binds an uploaded scene as group 0 (probes use the separate layout: `GpuScene::upload` on a device with
+    /// bindings enough).
     pub fn bind(&self, ctx: &GpuContext, scene: GpuScene) -> BoundScene {
-        let entries: Vec<_> = scene
-            .buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-            .collect();
         let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("probe scene"),
             layout: &self.scene_layout,
-            entries: &entries,
+            entries: &scene.bind_group_entries(),
         });
         BoundScene { scene, group }
     }
