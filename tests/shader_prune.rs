@@ -96,9 +96,19 @@ fn eval(kind: u32, x: f32) -> f32 {
     if (HAS_GLASS && kind == 1u) { return glass_eval(x); }
     return diffuse_eval(x);
 }
+override SPEC_SELECT: u32 = 0xffffffffu;
+fn cfg_select() -> u32 { return select(params.mode, SPEC_SELECT, SPEC_SELECT != 0xffffffffu); }
+fn by_tree() -> bool { return cfg_select() == 2u || cfg_select() == 3u; }
+fn tree_pick(x: f32) -> f32 { return x * 3.0; }
+fn pick(x: f32) -> f32 {
+    if (cfg_select() == 0u) { return x; }
+    if (by_tree()) { return tree_pick(x); }
+    return x + 0.125;
+}
 @compute @workgroup_size(1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var v = eval(id.x, f32(id.y));
+    v += pick(v);
     if (cfg_mode() == 1u) { v = path_only(v); } else { v = direct_only(v); }
     switch cfg_mode() {
         case 0u: { v += 3.0; }
@@ -116,7 +126,12 @@ fn functions(wgsl: &str) -> Vec<String> {
 fn fixed_settings_and_features_fold_and_open_ones_stay() {
     let module = mislab::render::shaders::validate(MODULE).unwrap();
     let fixed = specialized_wgsl(&module, "main", &[("SPEC_MODE", 1.0), ("HAS_GLASS", 0.0)]).unwrap();
-    assert_eq!(functions(&fixed), ["diffuse_eval", "path_only", "eval", "main"], "{fixed}");
+    // SPEC_SELECT is open: `pick` and what it calls stay.
+    assert_eq!(
+        functions(&fixed),
+        ["diffuse_eval", "path_only", "eval", "cfg_select", "by_tree", "tree_pick", "pick", "main"],
+        "{fixed}"
+    );
     assert!(!fixed.contains("override") && fixed.contains("4f"), "{fixed}");
     let open = specialized_wgsl(&module, "main", &[]).unwrap();
     for f in ["cfg_mode", "glass_eval", "diffuse_eval", "path_only", "direct_only"] {
@@ -125,6 +140,26 @@ fn fixed_settings_and_features_fold_and_open_ones_stay() {
     let direct = specialized_wgsl(&module, "main", &[("SPEC_MODE", 0.0)]).unwrap();
     assert!(functions(&direct).iter().any(|g| g == "direct_only") && !direct.contains("path_only"), "{direct}");
     assert!(direct.contains("glass_eval") && direct.contains("3f"), "{direct}");
+}
+
+/// `||` (which naga lowers to a local variable set in an `if`) folds through constant functions, and code after a
+/// branch that now always returns goes.
+#[test]
+fn short_circuits_and_code_after_a_return_fold() {
+    let module = mislab::render::shaders::validate(MODULE).unwrap();
+    let kept = |select: f64| {
+        let wgsl = specialized_wgsl(&module, "main", &[("SPEC_MODE", 0.0), ("SPEC_SELECT", select)]).unwrap();
+        let fns = functions(&wgsl);
+        (["by_tree", "tree_pick", "cfg_select"].map(|f| fns.iter().any(|g| g == f)), wgsl.contains("0.125f"), wgsl)
+    };
+    let (fns, half, wgsl) = kept(0.0);
+    assert!(fns == [false; 3] && !half, "uniform: everything after the first return goes\n{wgsl}");
+    let (fns, half, wgsl) = kept(3.0);
+    assert!(fns == [false, true, false] && !half, "tree (the second operand of ||)\n{wgsl}");
+    let (fns, half, wgsl) = kept(1.0);
+    assert!(fns == [false; 3] && half, "power: neither the first return nor the tree\n{wgsl}");
+    let open = specialized_wgsl(&module, "main", &[("SPEC_MODE", 0.0)]).unwrap();
+    assert!(["by_tree", "tree_pick", "cfg_select"].iter().all(|f| functions(&open).iter().any(|g| g == f)), "{open}");
 }
 
 /// Every pipeline the renderer specialises prunes (no fallback to the module as written), for every built-in scene

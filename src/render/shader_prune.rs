@@ -230,27 +230,36 @@ fn for_each_child(stmt: &mut Statement, mut f: impl FnMut(&mut Block)) {
 /// The value a function body returns when it is only expressions, stores to its simple locals and one `return`
 /// of a constant: no calls, no branches left, nothing written outside the function.
 fn constant_return(body: &Block, eval: &Eval) -> Option<Literal> {
-    let local_store = |s: &Statement| match s {
-        Statement::Emit(_) => true,
-        Statement::Store { pointer, .. } => eval.locals.variable(*pointer).is_some(),
-        _ => false,
-    };
     for stmt in body.iter() {
         match stmt {
-            s if local_store(s) => {}
+            Statement::Return { value: Some(v) } => return eval.literal(*v),
             Statement::Block(b) => {
                 if let Some(v) = constant_return(b, eval) {
                     return Some(v);
                 }
-                if !b.iter().all(local_store) {
+                if !pure(b, eval) {
                     return None;
                 }
             }
-            Statement::Return { value: Some(v) } => return eval.literal(*v),
+            s if pure_statement(s, eval) => {}
             _ => return None,
         }
     }
     None
+}
+
+/// Whether a block only computes expressions and stores to the function's simple locals.
+fn pure(block: &Block, eval: &Eval) -> bool {
+    block.iter().all(|s| pure_statement(s, eval))
+}
+
+fn pure_statement(s: &Statement, eval: &Eval) -> bool {
+    match s {
+        Statement::Emit(_) => true,
+        Statement::Store { pointer, .. } => eval.locals.variable(*pointer).is_some(),
+        Statement::Block(b) => pure(b, eval),
+        _ => false,
+    }
 }
 
 /// Constant folding of the expressions that settings and features build: literals, constants, comparisons,
@@ -337,7 +346,8 @@ type Known = HashMap<Handle<naga::LocalVariable>, Literal>;
 /// Prunes `block` in place, walking it in program order; `removed` gathers the expressions that the removed
 /// branches defined.
 fn prune_block(block: &mut Block, eval: &mut Eval, known: &mut Known, removed: &mut Vec<Handle<Expression>>) {
-    for stmt in block.iter_mut() {
+    let mut end = block.len();
+    for (index, stmt) in block.iter_mut().enumerate() {
         let taken = match stmt {
             Statement::Emit(range) => {
                 for h in range.clone() {
@@ -395,6 +405,27 @@ fn prune_block(block: &mut Block, eval: &mut Eval, known: &mut Known, removed: &
                 _ => {}
             },
         }
+        // What follows a statement that always leaves the block never runs (a pruned branch that returns, say).
+        if terminates(stmt) {
+            end = index + 1;
+            break;
+        }
+    }
+    if end < block.len() {
+        defined_in(&block[end..], removed);
+        block.cull(end..);
+    }
+}
+
+/// Whether a statement always leaves the block it is in (returns, breaks, continues or discards on every path).
+fn terminates(stmt: &Statement) -> bool {
+    match stmt {
+        Statement::Return { .. } | Statement::Kill | Statement::Break | Statement::Continue => true,
+        Statement::Block(b) => b.last().is_some_and(terminates),
+        Statement::If { accept, reject, .. } => {
+            accept.last().is_some_and(terminates) && reject.last().is_some_and(terminates)
+        }
+        _ => false,
     }
 }
 
@@ -454,7 +485,7 @@ fn breaks_out(block: &Block) -> bool {
 }
 
 /// Every expression a block's statements define (emit, or produce as a call's or an atomic's result).
-fn defined_in(block: &Block, out: &mut Vec<Handle<Expression>>) {
+fn defined_in(block: &[Statement], out: &mut Vec<Handle<Expression>>) {
     for stmt in block.iter() {
         match stmt {
             Statement::Emit(range) => out.extend(range.clone()),
