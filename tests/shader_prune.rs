@@ -80,7 +80,8 @@ fn pruned_pipelines_render_the_same_bits_as_the_module_as_written() {
 }
 
 /// A small module in the shape of the renderer's: settings as overrides read through functions, features joined
-/// by `&&`, a dispatcher, a switch on a setting.
+/// by `&&` (after a runtime operand too: `a && HAS_GLASS && f()` is false on both branches of `a`), a dispatcher,
+/// a switch on a setting.
 const MODULE: &str = r#"
 struct Params { mode: u32 }
 @group(0) @binding(0) var<uniform> params: Params;
@@ -89,6 +90,7 @@ override SPEC_MODE: u32 = 0xffffffffu;
 override HAS_GLASS: bool = true;
 fn cfg_mode() -> u32 { return select(params.mode, SPEC_MODE, SPEC_MODE != 0xffffffffu); }
 fn glass_eval(x: f32) -> f32 { return x * 0.5; }
+fn glass_cut(x: f32) -> bool { return x > 2.0; }
 fn diffuse_eval(x: f32) -> f32 { return x * 0.25; }
 fn path_only(x: f32) -> f32 { return x + 1.0; }
 fn direct_only(x: f32) -> f32 { return x + 2.0; }
@@ -109,6 +111,7 @@ fn pick(x: f32) -> f32 {
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var v = eval(id.x, f32(id.y));
     v += pick(v);
+    if (v != 0.0 && HAS_GLASS && glass_cut(v)) { v = 0.0; }
     if (cfg_mode() == 1u) { v = path_only(v); } else { v = direct_only(v); }
     switch cfg_mode() {
         case 0u: { v += 3.0; }
@@ -134,7 +137,7 @@ fn fixed_settings_and_features_fold_and_open_ones_stay() {
     );
     assert!(!fixed.contains("override") && fixed.contains("4f"), "{fixed}");
     let open = specialized_wgsl(&module, "main", &[]).unwrap();
-    for f in ["cfg_mode", "glass_eval", "diffuse_eval", "path_only", "direct_only"] {
+    for f in ["cfg_mode", "glass_eval", "glass_cut", "diffuse_eval", "path_only", "direct_only"] {
         assert!(functions(&open).iter().any(|g| g == f), "{f} is missing from the generic module:\n{open}");
     }
     let direct = specialized_wgsl(&module, "main", &[("SPEC_MODE", 0.0)]).unwrap();

@@ -389,14 +389,28 @@ fn prune_block(block: &mut Block, eval: &mut Eval, known: &mut Known, removed: &
             }
             None => match stmt {
                 Statement::Block(b) => prune_block(b, eval, known, removed),
-                Statement::If { .. } | Statement::Switch { .. } | Statement::Loop { .. } => {
-                    // Each branch (or iteration) starts from what is known before it, less what a loop's own
-                    // body may change; after it, nothing it stores to is known.
+                Statement::If { accept, reject, .. } => {
+                    // Both branches start from what is known before; after, a variable is known where every
+                    // branch that falls through leaves it the same (`a && B` with B false sets false either way).
+                    let (mut after_accept, mut after_reject) = (known.clone(), known.clone());
+                    prune_block(accept, eval, &mut after_accept, removed);
+                    prune_block(reject, eval, &mut after_reject, removed);
+                    *known = match (accept.last().is_some_and(terminates), reject.last().is_some_and(terminates)) {
+                        (true, false) => after_reject,
+                        (false, true) => after_accept,
+                        _ => {
+                            after_accept.retain(|v, l| after_reject.get(v) == Some(l));
+                            after_accept
+                        }
+                    };
+                }
+                Statement::Switch { .. } | Statement::Loop { .. } => {
+                    // Each case (or iteration) starts from what is known before it, less what a loop's own body
+                    // may change; after it, nothing it stores to is known.
                     let mut stored = HashSet::new();
                     for_each_child(stmt, |b| stored_in(b, eval.locals, &mut stored));
-                    let is_loop = matches!(stmt, Statement::Loop { .. });
                     let mut entry = known.clone();
-                    if is_loop {
+                    if matches!(stmt, Statement::Loop { .. }) {
                         entry.retain(|v, _| !stored.contains(v));
                     }
                     for_each_child(stmt, |b| prune_block(b, eval, &mut entry.clone(), removed));
