@@ -90,13 +90,6 @@ fn packed_and_separate_layouts_render_the_same_bits() {
         assert_same(name, &common::scene(name), &settings, 4);
     }
     // The BVH, textures and an environment map: every table of the layout read.
-    let helmet = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb"
-    );
-    let hdr = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/env/hdr/noon_grass_1k.hdr");
-    let mut scene = common::scene(helmet);
-    let map = mislab::scene::envmap::load_envmap(std::path::Path::new(hdr)).unwrap_or_else(|e| panic!("{hdr}: {e}")).0;
-    scene.environment = mislab::scene::Environment::Map { map: std::sync::Arc::new(map), scale: 1.0, rotation: 0.0 };
+    let scene = common::helmet_under_sky();
     assert_same("DamagedHelmet", &scene, &Settings { mode: Mode::Path, max_depth: 4, ..base.clone() }, 4);
 }

@@ -67,14 +67,7 @@ fn pruned_pipelines_render_the_same_bits_as_the_module_as_written() {
         assert_same_bits(name, pruned_and_as_written(&scene, &settings, 8));
     }
     // A BVH scene (more than the baked limit of primitives) with textures, under an environment map.
-    let helmet = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb"
-    );
-    let hdr = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/env/hdr/noon_grass_1k.hdr");
-    let mut scene = common::scene(helmet);
-    let map = mislab::scene::envmap::load_envmap(std::path::Path::new(hdr)).unwrap_or_else(|e| panic!("{hdr}: {e}")).0;
-    scene.environment = mislab::scene::Environment::Map { map: std::sync::Arc::new(map), scale: 1.0, rotation: 0.0 };
+    let scene = common::helmet_under_sky();
     let settings = Settings { mode: Mode::Path, max_depth: 4, ..base.clone() };
     assert_same_bits("DamagedHelmet", pruned_and_as_written(&scene, &settings, 4));
 }

@@ -25,6 +25,19 @@ pub fn scene(name: &str) -> Scene {
     scene::load(name, &LoadOptions::default()).unwrap_or_else(|e| panic!("loading {name}: {e}"))
 }
 
+/// The DamagedHelmet (a BVH, textures) under the noon_grass HDR map: a scene that reads every scene table.
+pub fn helmet_under_sky() -> Scene {
+    let helmet = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/testdata/gltf/khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb"
+    );
+    let hdr = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/env/hdr/noon_grass_1k.hdr");
+    let mut scene = self::scene(helmet);
+    let map = scene::envmap::load_envmap(std::path::Path::new(hdr)).unwrap_or_else(|e| panic!("{hdr}: {e}")).0;
+    scene.environment = scene::Environment::Map { map: std::sync::Arc::new(map), scale: 1.0, rotation: 0.0 };
+    scene
+}
+
 /// Renders `spp` samples of `scene` with `settings` and reads the film back.
 pub fn render(ctx: &GpuContext, scene: &Scene, settings: &Settings, spp: u32) -> Film {
     let gs = GpuScene::upload(ctx, SceneData::build(scene)).expect("upload");
