@@ -14,7 +14,7 @@
 //! The root is `nodes[0]`; nodes are in depth-first preorder (a left child directly follows its parent).
 //! Primitive references are `kind << 30 | index` ([`crate::gpu::types::make_prim`]).
 
-use std::time::Instant;
+use web_time::Instant;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3, Vec3A};

@@ -321,7 +321,7 @@ pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], 
 /// traversal is not compiled into pipelines that use the wide tree). `None` if the wide tree would be deeper than
 /// [`MAX_WIDE_DEPTH`] (the caller keeps the BVH2).
 pub fn widen(bvh: &Bvh) -> Option<Bvh> {
-    let start = std::time::Instant::now();
+    let start = web_time::Instant::now();
     let mut wide: Vec<GpuWideNode> = vec![GpuWideNode::default()];
     let mut refs: Vec<u32> = Vec::with_capacity(bvh.prim_refs.len());
     // (BVH2 node, wide node index, depth)

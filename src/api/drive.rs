@@ -8,7 +8,8 @@ use super::error::ApiError;
 use super::observer::{Observer, Progress};
 use crate::gpu::GpuContext;
 use crate::render::Renderer;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// Wall time one submission should take.
 pub const TARGET_SUBMIT_SECONDS: f64 = 1.0;

@@ -12,7 +12,7 @@ use super::scene::SceneHandle;
 use crate::render::settings::Settings;
 use crate::render::{reachability, Renderer};
 use crate::scene::SceneSpec;
-use std::time::Instant;
+use web_time::Instant;
 
 /// Renders `scene` as `job` says: start-up (upload, pipeline, a resumed state), the one loop to the budget with
 /// checkpoints, the state file written at the end, and the image read back. An observer's stop returns what has

@@ -5,7 +5,7 @@ use super::Renderer;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
 use crate::render::error::RenderError;
-use std::time::Instant;
+use web_time::Instant;
 
 /// What a timed render did (`Renderer::render_timed`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
