@@ -132,6 +132,26 @@ pub fn into_leaf_order(bvh: &mut Bvh, tri_count: usize) -> Vec<u32> {
 /// much). Reinsertion (moving subtrees to where they lower the SAH) starts from every node, before and after the
 /// leaf collapse, not the preset's 20 %: the build takes 2.5–3× as long (1M triangles: 2.3 → 6.9 s) and the trees
 /// render 0.86–1.0× the time (docs/profile-bvh.md, "BVH quality").
+/// obvhs's `build_bvh2` (PLOC, reinsertion, leaf collapse, reinsertion) without its timer: std's clock does not
+/// exist in a browser (wasm32), and the caller times the build itself.
+fn build_bvh2(aabbs: &[obvhs::aabb::Aabb], config: obvhs::BvhBuildParams) -> obvhs::bvh2::Bvh2 {
+    use obvhs::bvh2::{leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+    let indices = (0..aabbs.len() as u32).collect();
+    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
+        config.ploc_search_distance,
+        aabbs,
+        indices,
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh2, config.reinsertion_batch_ratio, None);
+    collapse(&mut bvh2, config.max_prims_per_leaf.clamp(1, 255), config.collapse_traversal_cost);
+    let ratio = config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier;
+    reinsertion.run(&mut bvh2, ratio, None);
+    bvh2
+}
+
 fn build_params() -> obvhs::BvhBuildParams {
     obvhs::BvhBuildParams {
         pre_split: false,
@@ -254,8 +274,7 @@ fn build_obvhs(boxes: &[Aabb]) -> (Vec<TmpNode>, Vec<u32>) {
     let norm = |p: Vec3| Vec3A::from(((p.as_dvec3() - center) * scale).as_vec3());
     let aabbs: Vec<obvhs::aabb::Aabb> =
         boxes.iter().map(|b| obvhs::aabb::Aabb::new(norm(b.min), norm(b.max))).collect();
-    let mut core_time = std::time::Duration::ZERO;
-    let bvh2 = obvhs::bvh2::builder::build_bvh2(&aabbs, build_params(), &mut core_time);
+    let bvh2 = build_bvh2(&aabbs, build_params());
 
     let mut tmp = Vec::with_capacity(bvh2.nodes.len());
     // obvhs: inner node children at first_index and first_index + 1; leaves index primitive_indices.

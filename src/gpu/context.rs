@@ -241,6 +241,19 @@ impl GpuContext {
         Ok(GpuContext { instance, adapter, device, queue, info, timestamps, pipelines })
     }
 
+    /// A context on a device opened elsewhere with `wanted`'s features and limits (a web page's, through eframe,
+    /// where nothing may block): no pipeline store.
+    pub fn from_device(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
+        let info = adapter.get_info();
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        GpuContext { instance, adapter, device, queue, info, timestamps, pipelines: PipelineMemo::default() }
+    }
+
     /// The features and limits we ask for: everything the adapter offers that we use.
     pub fn wanted(adapter: &wgpu::Adapter) -> (wgpu::Features, wgpu::Limits) {
         let available = adapter.features();

@@ -29,8 +29,11 @@ pub fn specialized_wgsl(module: &Module, entry: &str, constants: &[(&str, f64)])
     let mut module = module.into_owned();
     prune(&mut module);
     let info = validator.validate(&module).map_err(|e| format!("the pruned module does not validate: {e:?}"))?;
-    naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
-        .map_err(|e| format!("writing the pruned module: {e}"))
+    let wgsl = naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+        .map_err(|e| format!("writing the pruned module: {e}"))?;
+    // naga writes f32::MAX as its shortest decimal, 3.4028235e38, which lies above f32::MAX: naga reads it back, but
+    // Chromium's WGSL compiler (Tint) refuses it as out of range. Its exact hexadecimal form is the same value.
+    Ok(wgsl.replace("340282350000000000000000000000000000000f", "0x1.fffffep+127f"))
 }
 
 /// Folds constant calls and branches in every function (callees first: naga orders functions before their

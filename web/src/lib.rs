@@ -1,0 +1,40 @@
+//! mislab on a web page: the renderer and its shaders on the browser's WebGPU, under an egui panel that switches
+//! the estimator live while the image converges. Built by `scripts/web/build.sh` into `target/web/`.
+//!
+//! Nothing here blocks: each frame records one sample per pixel, copies the accumulators to a staging buffer and
+//! asks for it mapped; a later frame, once the browser has mapped it, turns it into the image. The scene's tables
+//! are packed into one buffer where the adapter binds fewer storage buffers than the separate layout needs
+//! (`mislab::render::packed_scene`).
+
+mod lab;
+
+pub use lab::WebLab;
+
+#[cfg(target_arch = "wasm32")]
+mod page {
+    use wasm_bindgen::prelude::*;
+    use wasm_bindgen::JsCast;
+
+    /// The page's entry point: the egui app on the canvas `#mislab`.
+    #[wasm_bindgen(start)]
+    pub fn start() {
+        std::panic::set_hook(Box::new(|info| {
+            let message = format!("mislab panicked: {info}");
+            web_sys::console::error_1(&message.clone().into());
+            super::lab::report(&message);
+        }));
+        wasm_bindgen_futures::spawn_local(async {
+            let document = web_sys::window().and_then(|w| w.document()).expect("a document");
+            let canvas = document
+                .get_element_by_id("mislab")
+                .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
+                .expect("a canvas #mislab");
+            let started = eframe::WebRunner::new()
+                .start(canvas, super::lab::web_options(), Box::new(|cc| Ok(Box::new(super::WebLab::new(cc)?))))
+                .await;
+            if let Err(e) = started {
+                super::lab::report(&format!("error: no WebGPU device for mislab ({e:?})"));
+            }
+        });
+    }
+}
