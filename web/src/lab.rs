@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
-const SCENES: &[&str] = &["veach-mis", "cornell-box", "area-vs-cosine", "furnace"];
+const SCENES: &[&str] = &["veach-mis", "cornell-box", "area-vs-cosine", "furnace", "many-lights"];
 const STRATEGIES: &[Strategy] = &[Strategy::Uniform, Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::Mis];
 
 /// eframe's options: a WebGPU device with every feature and limit mislab uses that the adapter offers.
