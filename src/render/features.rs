@@ -9,6 +9,13 @@ use crate::render::settings::Settings;
 /// `Features::occluders` of the generic pipeline: whatever `FrameParams::occluder_count` says at run time.
 pub const GENERIC_OCCLUDERS: u32 = u32::MAX;
 
+/// Whether a device of `backend` gets scenes baked into its shaders (`render::baked`). Not a browser's WebGPU:
+/// Chromium's SwiftShader never finished the first dispatch of a baked kernel (veach-mis, cornell-box) in minutes,
+/// while the buffer-reading path renders the native means there (docs/web.md).
+pub fn bakes(backend: wgpu::Backend) -> bool {
+    backend != wgpu::Backend::BrowserWebGpu
+}
+
 /// What kind of environment the scene has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum EnvKind {
@@ -157,6 +164,15 @@ impl Features {
             }),
             packed_scene: false,
         }
+    }
+
+    /// `of` for a device of `backend`: without the baked paths where it does not bake (`bakes`).
+    pub fn for_backend(data: &SceneData, backend: wgpu::Backend) -> Features {
+        let f = Features::of(data);
+        if bakes(backend) {
+            return f;
+        }
+        Features { flat: None, occluders: 0, baked_root: false, baked: 0, ..f }
     }
 
     /// The WGSL override constants for these features.
