@@ -7,7 +7,7 @@ use crate::gpu::{GpuContext, GpuError};
 use crate::render::bindings;
 use crate::render::env_guide;
 pub use crate::render::error::{InvalidSettings, RenderError};
-use crate::render::features::{self, Features, PipelineKey};
+use crate::render::features::{Features, PipelineKey};
 use crate::render::film::Film;
 use crate::render::gpu_scene::GpuScene;
 use crate::render::packed_scene::{for_layout, SceneLayout};
@@ -242,11 +242,8 @@ impl Renderer {
             occluders: d.occluders,
             origin: d.origin,
             offset_scale: d.offset_scale,
-            source: for_layout(
-                if features::bakes(ctx.info.backend) { render_source_for(d) } else { render_source() },
-                scene.layout,
-            )
-            .map_err(RenderError::Pipeline)?,
+            // Read only by baked pipelines (`source_for`), which a device that does not bake never keys.
+            source: for_layout(render_source_for(d), scene.layout).map_err(RenderError::Pipeline)?,
             shared_source: for_layout(render_source(), scene.layout).map_err(RenderError::Pipeline)?,
             guide_grid,
             guide_cdf,
