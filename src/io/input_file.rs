@@ -93,9 +93,25 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), InputError> {
     Ok((file, meta.len()))
 }
 
+/// Whether `path` is an input that can be read (a regular file, or a file of the active `memory_files` set), and
+/// its size: the check a loader makes before it hands a file to another.
+pub fn check_readable(path: &Path) -> Result<u64, InputError> {
+    match crate::io::memory_files::lookup(path) {
+        Some(held) => held.map(|b| b.len() as u64),
+        None => open_regular(path).map(|(_, len)| len),
+    }
+}
+
 /// Reads a whole regular file of at most `limit` bytes (see `open_regular`), refusing larger ones before
 /// reading them and never reading more than `limit` bytes however the file changes meanwhile.
 pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
+    if let Some(held) = crate::io::memory_files::lookup(path) {
+        let bytes = held?;
+        if bytes.len() as u64 > limit {
+            return Err(InputError::TooLarge { bytes: bytes.len() as u64, limit });
+        }
+        return Ok(bytes.to_vec());
+    }
     let (file, len) = open_regular(path)?;
     let over = |bytes: u64| InputError::TooLarge { bytes, limit };
     if len > limit {
@@ -112,6 +128,10 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
 /// The first `max` bytes of a regular file (all of it when shorter): for inputs that declare their own
 /// length, such as glTF buffers, which may be followed by more data that is not read.
 pub fn read_prefix(path: &Path, max: u64) -> Result<Vec<u8>, InputError> {
+    if let Some(held) = crate::io::memory_files::lookup(path) {
+        let bytes = held?;
+        return Ok(bytes[..bytes.len().min(max as usize)].to_vec());
+    }
     let (file, len) = open_regular(path)?;
     let mut bytes = Vec::with_capacity(len.min(max) as usize);
     file.take(max).read_to_end(&mut bytes).map_err(InputError::Read)?;

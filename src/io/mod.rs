@@ -4,4 +4,5 @@ pub mod cli_values;
 pub mod error;
 pub mod exr_image;
 pub mod input_file;
+pub mod memory_files;
 pub mod output_file;

@@ -30,25 +30,33 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
             )))
         }
     };
-    // A regular file only (a FIFO would block, /dev/zero never ends), and within the documented size limit.
-    let (file, len) = crate::io::input_file::open_regular(path).map_err(|m| match m {
+    let limit = crate::io::input_file::MAX_ENVMAP_BYTES;
+    let too_large = |len: u64| err(format!("environment map is {len} bytes, over the limit of {limit} bytes"));
+    let not_readable = |m: crate::io::input_file::InputError| match m {
         crate::io::input_file::InputError::NotFound => err("environment map not found".into()),
         _ => err(format!("environment map {m}")),
-    })?;
-    let limit = crate::io::input_file::MAX_ENVMAP_BYTES;
-    if len > limit {
-        return Err(err(format!("environment map is {len} bytes, over the limit of {limit} bytes")));
-    }
-    if len == 0 {
-        return Err(err("empty file (0 bytes)".into()));
-    }
-    if format == image::ImageFormat::Hdr {
-        check_hdr_header(&file, len).map_err(err)?;
-    }
+    };
     // Decoders can panic on corrupt data (an overflowing run-length multiplier in the Radiance decoder, for
     // one): that is an error about this file, not a crash.
-    super::catch_quietly(|| decode(path, file, format))
-        .unwrap_or_else(|panic| Err(err(format!("corrupt {} file (the decoder failed: {panic})", name(format)))))
+    let decoded = if let Some(held) = crate::io::memory_files::lookup(path) {
+        // A file given in memory (a web page's dropped file).
+        let bytes = held.map_err(not_readable)?;
+        let len = bytes.len() as u64;
+        if len > limit {
+            return Err(too_large(len));
+        }
+        check_size_and_header(&bytes[..bytes.len().min(HDR_HEADER_SCAN as usize)], len, format).map_err(err)?;
+        super::catch_quietly(|| decode(path, std::io::Cursor::new(&bytes[..]), format))
+    } else {
+        // A regular file only (a FIFO would block, /dev/zero never ends), and within the documented size limit.
+        let (file, len) = crate::io::input_file::open_regular(path).map_err(not_readable)?;
+        if len > limit {
+            return Err(too_large(len));
+        }
+        check_size_and_header(&file_head(&file).map_err(err)?, len, format).map_err(err)?;
+        super::catch_quietly(|| decode(path, BufReader::new(file), format))
+    };
+    decoded.unwrap_or_else(|panic| Err(err(format!("corrupt {} file (the decoder failed: {panic})", name(format)))))
 }
 
 /// How much of a Radiance file is searched for the end of its header.
@@ -57,13 +65,13 @@ const HDR_HEADER_SCAN: u64 = 64 << 10;
 /// A Radiance header is the signature line, attribute lines, an empty line, then the resolution line. A file
 /// that starts like one but ends before the resolution line is cut short; the decoder would report the first
 /// partial line it meets as a bad attribute or dimension instead.
-fn check_hdr_header(file: &std::fs::File, len: u64) -> Result<(), String> {
-    use std::io::{Read, Seek};
-    let unreadable = |e: std::io::Error| format!("cannot read environment map: {e}");
-    let mut head = Vec::new();
-    let mut reader = file; // `Read` and `Seek` are implemented for `&File`: the caller's handle is rewound
-    reader.take(HDR_HEADER_SCAN).read_to_end(&mut head).map_err(unreadable)?;
-    reader.rewind().map_err(unreadable)?;
+fn check_size_and_header(head: &[u8], len: u64, format: image::ImageFormat) -> Result<(), String> {
+    if len == 0 {
+        return Err("empty file (0 bytes)".into());
+    }
+    if format != image::ImageFormat::Hdr {
+        return Ok(());
+    }
     if !head.starts_with(b"#?RADIANCE") || len > HDR_HEADER_SCAN {
         return Ok(()); // not a Radiance file at all, or too long to be a cut header: the decoder says what is wrong
     }
@@ -79,9 +87,24 @@ fn check_hdr_header(file: &std::fs::File, len: u64) -> Result<(), String> {
     ))
 }
 
-fn decode(path: &Path, file: std::fs::File, format: image::ImageFormat) -> Result<(EnvMap, Vec<String>), SceneError> {
+/// The first `HDR_HEADER_SCAN` bytes of `file`, which is rewound after.
+fn file_head(file: &std::fs::File) -> Result<Vec<u8>, String> {
+    use std::io::{Read, Seek};
+    let unreadable = |e: std::io::Error| format!("cannot read environment map: {e}");
+    let mut head = Vec::new();
+    let mut reader = file; // `Read` and `Seek` are implemented for `&File`: the caller's handle is rewound
+    reader.take(HDR_HEADER_SCAN).read_to_end(&mut head).map_err(unreadable)?;
+    reader.rewind().map_err(unreadable)?;
+    Ok(head)
+}
+
+fn decode(
+    path: &Path,
+    input: impl std::io::BufRead + std::io::Seek,
+    format: image::ImageFormat,
+) -> Result<(EnvMap, Vec<String>), SceneError> {
     let err = |message: String| SceneError::new(path, message);
-    let mut reader = image::ImageReader::with_format(BufReader::new(file), format);
+    let mut reader = image::ImageReader::with_format(input, format);
     // The default 512 MiB cap would refuse a legitimate 8k×4k RGBA f32 EXR; MAX_SIDE already bounds the size, so
     // allow what a MAX_SIDE×MAX_SIDE/2 RGBA f32 map needs (2 GiB) and refuse larger ones by size, with a clear message.
     let mut limits = image::Limits::default();

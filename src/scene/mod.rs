@@ -580,13 +580,20 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         return Ok(scene);
     }
     let path = Path::new(name_or_path);
-    // symlink_metadata: a dangling link or a link loop exists, and open_regular says which it is.
-    if path.symlink_metadata().is_err() {
+    let in_memory = crate::io::memory_files::active();
+    // symlink_metadata: a dangling link or a link loop exists, and check_readable says which it is.
+    let exists =
+        if in_memory { crate::io::input_file::check_readable(path).is_ok() } else { path.symlink_metadata().is_ok() };
+    if !exists {
         let names = builtin::NAMES.join(", ");
-        return Err(SceneError::new(path, format!("no such file, and not a built-in scene (built-ins: {names})")));
+        let given = if in_memory { " among the files given" } else { "" };
+        return Err(SceneError::new(
+            path,
+            format!("no such file{given}, and not a built-in scene (built-ins: {names})"),
+        ));
     }
     // Anything but a regular file (a FIFO would block, /dev/zero never ends) is refused before a loader opens it.
-    crate::io::input_file::open_regular(path).map_err(|m| SceneError::new(path, m.to_string()))?;
+    crate::io::input_file::check_readable(path).map_err(|m| SceneError::new(path, m.to_string()))?;
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
     if ext.is_empty() {
         return Err(SceneError::new(
@@ -611,6 +618,17 @@ pub fn load(name_or_path: &str, options: &LoadOptions) -> Result<Scene, SceneErr
         Ok(r) => r.and_then(|s| check_packing_limits(path, &s).and_then(|()| check_finite(path, &s)).map(|()| s)),
         Err(what) => Err(SceneError::new(path, format!("malformed file (the loader failed: {what})"))),
     }
+}
+
+/// Loads the scene file `main` (a built-in name, or one of `files`) with `files` as the only files it and its
+/// references can read: a web page's dropped files, or scene files a host program holds in memory
+/// (`io::memory_files` says how names resolve).
+pub fn load_from_files(
+    main: &str,
+    files: &crate::io::memory_files::MemoryFiles,
+    options: &LoadOptions,
+) -> Result<Scene, SceneError> {
+    crate::io::memory_files::with_files(files, || load(main, options))
 }
 
 /// Runs `f`, turning a panic into `Err(its message)` without printing it: a decoder or loader that panics on

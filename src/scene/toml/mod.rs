@@ -541,7 +541,7 @@ fn include(
 
     let path = ctx.resolve(&d.gltf);
     // The same check every input gets (a FIFO, a directory or /dev/zero is named as what it is).
-    if let Err(m) = crate::io::input_file::open_regular(&path) {
+    if let Err(m) = crate::io::input_file::check_readable(&path) {
         let m = match m {
             crate::io::input_file::InputError::NotFound => "not found".to_string(),
             m => m.to_string(),
