@@ -5,6 +5,7 @@
 
 pub mod baked;
 pub mod bindings;
+pub mod display;
 pub mod env_guide;
 pub mod error;
 pub mod features;

@@ -3,9 +3,9 @@
 //! statistics, camera control, opening and saving files. Runs the same under eframe and egui_kittest.
 
 use super::camera::Orbit;
-use super::display::{self, View, TONEMAPS};
 use super::engine::{Command, DisplayOptions, EngineHandle, Frame, Side, SideStats};
 use super::widgets::{choice, labelled, legend, path_row, plain, settings_grid, stats_grid};
+use crate::render::display::{self, View, TONEMAPS};
 use crate::render::settings::*;
 use eframe::egui;
 use egui::{Color32, Pos2, Rect, Sense, Vec2};

@@ -7,16 +7,15 @@ pub mod app;
 pub mod error;
 pub use error::ViewerError;
 pub mod camera;
-pub mod display;
 pub mod engine;
 pub mod widgets;
 
 use crate::gpu::GpuContext;
+use crate::render::display::View;
 use crate::render::film::Tonemap;
 use crate::render::settings::{Settings, Strategy};
 use crate::scene::{Scene, SceneSpec};
 use app::Viewer;
-use display::View;
 use eframe::{egui, egui_wgpu};
 use engine::{DisplayOptions, EngineConfig};
 use std::path::PathBuf;

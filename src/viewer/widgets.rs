@@ -1,8 +1,8 @@
 //! The settings panel's widgets (egui): the A | B settings grid under the CLI's names, path rows, the
 //! statistics grid and the false-colour legend, with the small helpers they share.
 
-use super::display::{self, View};
 use super::engine::SideStats;
+use crate::render::display::{self, View};
 use crate::render::settings::*;
 use eframe::egui;
 use egui::{Color32, Pos2, Rect, Sense, Vec2};

@@ -1,9 +1,9 @@
 //! How each [`Command`] from the UI changes the engine: settings, comparison, camera, display options,
 //! scene, environment and reference loading, EXR saving, and the test hook that loses the device.
 
-use super::display;
 use super::side::SideState;
 use super::{scene_centre, Command, Engine};
+use crate::render::display;
 use crate::render::settings::Settings;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::scene::{self, Environment, LoadOptions, Scene};
@@ -86,7 +86,11 @@ impl Engine {
             },
             Command::LoadReference(path) => {
                 let (w, h) = (self.settings[0].width, self.settings[0].height);
-                match display::load_reference(&path, w, h) {
+                let read = crate::io::input_file::read_bounded(&path, crate::io::input_file::MAX_ENVMAP_BYTES)
+                    .map_err(|e| e.to_string())
+                    .and_then(|bytes| display::decode_reference(&bytes, w, h))
+                    .map_err(|e| format!("{}: {e}", path.display()));
+                match read {
                     Ok(rgb) => {
                         self.reference = Some(display::upload_reference(&self.ctx, &rgb));
                         self.shared().has_reference = true;

@@ -1,9 +1,9 @@
 //! One engine frame: a bounded dispatch per active side, the display pass, the readback, and the
 //! book-keeping after it (GPU timestamps per dispatch, cost estimates, the frame and statistics for the UI).
 
-use super::display::{self, DisplayInputs, DisplayParams, ImageStats};
 use super::{Engine, Frame, PipelineState, SideStats, FRAME_BUDGET_S, MAX_SPP, PREVIEW_SCALE, STATS_INTERVAL};
 use crate::gpu::GpuError;
+use crate::render::display::{self, DisplayInputs, DisplayParams, ImageStats};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;

@@ -12,9 +12,9 @@
 //! (device loss and recreation), `commands` (how each command changes the engine); this file holds the
 //! tuning constants, the engine's state and its loop.
 
-use super::display::{self, DisplayPass, ImageStats};
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
+use crate::render::display::{DisplayPass, ImageStats};
 use crate::render::features::PipelineKey;
 use crate::render::pipeline_cache::PipelineCache;
 use crate::render::settings::Settings;

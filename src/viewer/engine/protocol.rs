@@ -2,10 +2,10 @@
 //! [`Frame`], [`SideStats`]), what the engine starts with ([`EngineConfig`]) and the UI's handle on the
 //! thread ([`EngineHandle`], made by [`spawn`]).
 
-use super::display::ImageStats;
-use super::display::View;
 use super::Engine;
 use crate::gpu::GpuContext;
+use crate::render::display::ImageStats;
+use crate::render::display::View;
 use crate::render::film::Tonemap;
 use crate::render::settings::Settings;
 use crate::scene::{Camera, Scene};

@@ -1,11 +1,11 @@
 //! Device loss and GPU errors: the callbacks that report them, and recreating the device and everything
 //! on it (scene, sides, display pass, compile worker, timer) so the render restarts instead of stopping.
 
-use super::display::DisplayPass;
 use super::side::SideState;
 use super::Engine;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::GpuContext;
+use crate::render::display::DisplayPass;
 use crate::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use crate::viewer::ViewerError;
 use std::sync::atomic::{AtomicBool, Ordering};

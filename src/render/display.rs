@@ -1,11 +1,11 @@
 //! The display pass (shaders/display.wgsl): the accumulators of both sides of a comparison → the RGBA8
-//! image the window shows, plus per-workgroup statistics sums; the false-colour scale's CPU twin for the
-//! legend.
+//! image a viewer shows (the native window's and the web page's), plus per-workgroup statistics sums; the
+//! false-colour scale's CPU twin for the legend.
 
 use crate::gpu::types::GpuAccum;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::film::Tonemap;
-use crate::viewer::ViewerError;
+use crate::render::RenderError;
 use bytemuck::{Pod, Zeroable};
 
 /// WGSL files of the display entry point, in order.
@@ -206,7 +206,7 @@ pub struct DisplayOutput {
 
 impl DisplayPass {
     /// Builds the display pipeline for a `width`×`height` film.
-    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<DisplayPass, ViewerError> {
+    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<DisplayPass, RenderError> {
         let device = ctx.device.clone();
         let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
             binding,
@@ -248,7 +248,7 @@ impl DisplayPass {
                 )
             })
             .collect::<Result<Vec<_>, _>>()
-            .map_err(ViewerError::Input)?;
+            .map_err(RenderError::Pipeline)?;
         let stats_pipeline = crate::render::shaders::compute_pipeline(
             &device,
             None,
@@ -258,7 +258,7 @@ impl DisplayPass {
             &[],
             Some(&pipeline_layout),
         )
-        .map_err(ViewerError::Input)?;
+        .map_err(RenderError::Pipeline)?;
         let workgroups = (width.div_ceil(8), height.div_ceil(8));
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -367,7 +367,7 @@ impl DisplayPass {
         }
     }
 
-    /// Maps the staging buffer (after the submission that `encode` recorded into) and reads it.
+    /// Maps the staging buffer (after the submission that `encode` recorded into), waits for it and reads it.
     pub fn read(&self, ctx: &GpuContext, stats: bool) -> Result<DisplayOutput, GpuError> {
         let (tx, rx) = std::sync::mpsc::channel();
         self.staging.map_async(wgpu::MapMode::Read, .., move |r| {
@@ -379,6 +379,16 @@ impl DisplayPass {
             Ok(Err(e)) => return Err(GpuError::Map(e.to_string())),
             Err(_) => return Err(GpuError::Map("the map callback never ran".into())),
         }
+        self.read_mapped(stats)
+    }
+
+    /// The staging buffer, for a caller that cannot block (a web page) to map itself; then `read_mapped`.
+    pub fn staging(&self) -> &wgpu::Buffer {
+        &self.staging
+    }
+
+    /// Reads the staging buffer once it is mapped, and unmaps it.
+    pub fn read_mapped(&self, stats: bool) -> Result<DisplayOutput, GpuError> {
         let image_bytes = (self.width as usize) * (self.height as usize) * 4;
         let out = {
             let data = self.staging.get_mapped_range(..).map_err(|e| GpuError::Map(format!("{e:?}")))?;
@@ -405,23 +415,21 @@ pub fn upload_reference(ctx: &GpuContext, rgb: &[[f32; 3]]) -> wgpu::Buffer {
     ctx.storage_buffer("reference", &data, wgpu::BufferUsages::empty())
 }
 
-/// Reads a reference EXR (or any float image `image` decodes) and checks it matches the film size.
-pub fn load_reference(path: &std::path::Path, width: u32, height: u32) -> Result<Vec<[f32; 3]>, ViewerError> {
-    let img = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| ViewerError::Input(format!("{}: {e}", path.display())))?
+/// Decodes a reference image (an EXR, or any float image `image` reads) of the film's size: linear RGB per pixel.
+/// The error says what is wrong; the caller names the file.
+pub fn decode_reference(bytes: &[u8], width: u32, height: u32) -> Result<Vec<[f32; 3]>, String> {
+    let img = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?
         .decode()
-        .map_err(|e| ViewerError::Input(format!("{}: could not read the reference: {e}", path.display())))?
+        .map_err(|e| format!("could not read the reference: {e}"))?
         .to_rgb32f();
     if img.width() != width || img.height() != height {
-        return Err(ViewerError::Input(format!(
-            "{}: the reference is {}x{} but the film is {}x{} (render it with the same --width/--height)",
-            path.display(),
+        return Err(format!(
+            "the reference is {}x{} but the film is {width}x{height} (render it with the same --width/--height)",
             img.width(),
             img.height(),
-            width,
-            height
-        )));
+        ));
     }
     Ok(img.pixels().map(|p| p.0).collect())
 }
