@@ -15,12 +15,11 @@ pub mod api;
 pub mod gpu;
 pub mod io;
 // The lab's commands and the native viewer are processes with threads, signals and terminals; a wasm32 build (the
-// browser, issue 45) has the layers below them.
+// browser, issue 45) has the layers below them, and of the viewer its panel's widgets.
 #[cfg(not(target_arch = "wasm32"))]
 pub mod lab;
 pub mod render;
 pub mod scene;
 pub mod state;
 pub mod testkit;
-#[cfg(not(target_arch = "wasm32"))]
 pub mod viewer;

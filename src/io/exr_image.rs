@@ -29,6 +29,16 @@ pub fn write(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Res
 
 /// Encodes `image` as linear RGB float32 EXR at `path`, with `attributes` as text attributes of the layer.
 pub fn encode(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Result<(), exr::error::Error> {
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    encode_into(file, image, attributes)
+}
+
+/// `encode` into any seekable writer (a `Cursor` over the bytes of a browser download).
+pub fn encode_into(
+    out: impl std::io::Write + std::io::Seek,
+    image: Pixels,
+    attributes: &[(String, String)],
+) -> Result<(), exr::error::Error> {
     use exr::prelude::*;
     let (w, h) = (image.width as usize, image.height as usize);
     let mut layer_attributes = LayerAttributes::named("mislab");
@@ -46,7 +56,7 @@ pub fn encode(path: &Path, image: Pixels, attributes: &[(String, String)]) -> Re
             (c[0], c[1], c[2])
         }),
     );
-    Image::from_layer(layer).write().to_file(path)
+    Image::from_layer(layer).write().to_buffered(out)
 }
 
 /// A reference read back: size, linear RGB pixels, and its text attributes.

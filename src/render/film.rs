@@ -145,10 +145,39 @@ impl Film {
     }
 }
 
-/// An 8-bit sRGB PNG with an sRGB chunk and one tEXt chunk per attribute.
 fn write_png(path: &Path, img: &image::RgbImage, attributes: &[(String, String)]) -> Result<(), png::EncodingError> {
-    let file = std::fs::File::create(path)?;
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), img.width(), img.height());
+    encode_png(std::io::BufWriter::new(std::fs::File::create(path)?), img, attributes)
+}
+
+impl Film {
+    /// The image as the bytes of a file of `format` (`png`: tonemapped; `exr`: linear), with `attributes` in its
+    /// header, for a caller that writes no file itself (a browser's download).
+    pub fn encoded(
+        &self,
+        format: &str,
+        exposure: f32,
+        op: Tonemap,
+        attributes: &[(String, String)],
+    ) -> Result<Vec<u8>, String> {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        match format {
+            "png" => encode_png(&mut bytes, &self.to_rgb8(exposure, op), attributes).map_err(|e| e.to_string())?,
+            "exr" => {
+                crate::io::exr_image::encode_into(&mut bytes, self.pixels(), attributes).map_err(|e| e.to_string())?
+            }
+            _ => return Err(format!("unknown image format '{format}' (png or exr)")),
+        }
+        Ok(bytes.into_inner())
+    }
+}
+
+/// An 8-bit sRGB PNG with an sRGB chunk and one tEXt chunk per attribute.
+fn encode_png(
+    out: impl std::io::Write,
+    img: &image::RgbImage,
+    attributes: &[(String, String)],
+) -> Result<(), png::EncodingError> {
+    let mut encoder = png::Encoder::new(out, img.width(), img.height());
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -160,4 +189,26 @@ fn write_png(path: &Path, img: &image::RgbImage, attributes: &[(String, String)]
     let mut writer = encoder.write_header()?;
     writer.write_image_data(img.as_raw())?;
     writer.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encoded_files_decode_to_the_film() {
+        let accum: Vec<GpuAccum> = (0..6)
+            .map(|i| GpuAccum { mean: [i as f32 * 0.25, 0.5, 2.0], count: 4, m2: [0.0; 3], nonfinite: 0 })
+            .collect();
+        let film = Film::from_accum(3, 2, &accum, 0);
+        let attributes = [("spp".to_string(), "4".to_string())];
+        let png = film.encoded("png", 0.0, Tonemap::Clamp, &attributes).unwrap();
+        let decoded = image::load_from_memory_with_format(&png, image::ImageFormat::Png).unwrap().to_rgb8();
+        assert_eq!(decoded, film.to_rgb8(0.0, Tonemap::Clamp));
+        let exr = film.encoded("exr", 0.0, Tonemap::Clamp, &attributes).unwrap();
+        let decoded = image::load_from_memory_with_format(&exr, image::ImageFormat::OpenExr).unwrap().to_rgb32f();
+        let values: Vec<[f32; 3]> = decoded.pixels().map(|p| p.0).collect();
+        assert_eq!(values, film.mean);
+        assert!(film.encoded("jpg", 0.0, Tonemap::Clamp, &[]).is_err());
+    }
 }

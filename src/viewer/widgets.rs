@@ -1,7 +1,6 @@
 //! The settings panel's widgets (egui): the A | B settings grid under the CLI's names, path rows, the
 //! statistics grid and the false-colour legend, with the small helpers they share.
 
-use super::engine::SideStats;
 use crate::render::display::{self, View};
 use crate::render::settings::*;
 use eframe::egui;
@@ -9,7 +8,7 @@ use egui::{Color32, Pos2, Rect, Sense, Vec2};
 
 /// Messages can quote compiler output (naga draws boxes with U+2500..): keep what egui's default
 /// fonts can draw.
-pub(crate) fn plain(s: &str) -> String {
+pub fn plain(s: &str) -> String {
     s.chars()
         .map(|c| match c {
             '\u{2500}'..='\u{257F}' => '-',
@@ -27,12 +26,7 @@ pub(crate) fn plain(s: &str) -> String {
 }
 
 /// A label and a widget named by it (kittest and screen readers find the widget by the label).
-pub(crate) fn labelled(
-    ui: &mut egui::Ui,
-    name: &str,
-    add: impl FnOnce(&mut egui::Ui) -> egui::Response,
-    changed: &mut bool,
-) {
+pub fn labelled(ui: &mut egui::Ui, name: &str, add: impl FnOnce(&mut egui::Ui) -> egui::Response, changed: &mut bool) {
     ui.horizontal(|ui| {
         let l = ui.label(name);
         let r = add(ui).labelled_by(l.id);
@@ -41,7 +35,7 @@ pub(crate) fn labelled(
 }
 
 /// A combo box named `label` choosing among `all`; returns whether the value changed.
-pub(crate) fn choice<T: Copy + PartialEq>(
+pub fn choice<T: Copy + PartialEq>(
     ui: &mut egui::Ui,
     id: String,
     label: &str,
@@ -61,7 +55,7 @@ pub(crate) fn choice<T: Copy + PartialEq>(
 }
 
 /// A combo box without a label of its own, named by `label` (the row's label in a grid).
-pub(crate) fn grid_choice<T: Copy + PartialEq>(
+pub fn grid_choice<T: Copy + PartialEq>(
     ui: &mut egui::Ui,
     id: String,
     label: egui::Id,
@@ -132,7 +126,7 @@ pub fn settings_grid(ui: &mut egui::Ui, settings: &mut [Settings; 2], sides: usi
 }
 
 /// A path field with its button; true when the button is clicked or Enter pressed in the field.
-pub(crate) fn path_row(ui: &mut egui::Ui, name: &str, value: &mut String, button: &str) -> bool {
+pub fn path_row(ui: &mut egui::Ui, name: &str, value: &mut String, button: &str) -> bool {
     let mut go = false;
     ui.horizontal(|ui| {
         let l = ui.label(name);
@@ -147,12 +141,13 @@ pub(crate) fn path_row(ui: &mut egui::Ui, name: &str, value: &mut String, button
     go && !value.trim().is_empty()
 }
 
-pub(crate) fn fmt_opt(v: Option<f64>, digits: usize) -> String {
+pub fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     v.map(|x| format!("{x:.digits$}")).unwrap_or_else(|| "—".into())
 }
 
 /// The statistics of one or two sides as a grid.
-pub(crate) fn stats_grid(ui: &mut egui::Ui, stats: &[SideStats], has_reference: bool) {
+#[cfg(not(target_arch = "wasm32"))]
+pub fn stats_grid(ui: &mut egui::Ui, stats: &[super::engine::SideStats], has_reference: bool) {
     egui::Grid::new("mislab-stats").num_columns(stats.len() + 1).striped(true).show(ui, |ui| {
         if stats.len() == 2 {
             ui.label("");
@@ -160,14 +155,14 @@ pub(crate) fn stats_grid(ui: &mut egui::Ui, stats: &[SideStats], has_reference: 
             ui.strong("B");
             ui.end_row();
         }
-        let row = |ui: &mut egui::Ui, name: &str, f: &dyn Fn(&SideStats) -> String| {
+        let row = |ui: &mut egui::Ui, name: &str, f: &dyn Fn(&super::engine::SideStats) -> String| {
             ui.label(name);
             for s in stats {
                 ui.monospace(f(s));
             }
             ui.end_row();
         };
-        let height = |s: &SideStats| s.settings.height.max(1);
+        let height = |s: &super::engine::SideStats| s.settings.height.max(1);
         row(ui, "spp", &|s| {
             if s.pass_rows > 0 {
                 format!("{} (+{}/{} rows)", s.spp, s.pass_rows, height(s))
@@ -193,7 +188,7 @@ pub(crate) fn stats_grid(ui: &mut egui::Ui, stats: &[SideStats], has_reference: 
 }
 
 /// The false-colour legend: the colour bar with a tick per decade.
-pub(crate) fn legend(ui: &mut egui::Ui, view: View, range: [f32; 2]) {
+pub fn legend(ui: &mut egui::Ui, view: View, range: [f32; 2]) {
     let title = match view {
         View::StdErr => "standard error of the pixel mean (log scale)",
         _ => "relMSE = (x - ref)^2 / (ref^2 + 0.01) (log scale)",
