@@ -1,128 +1,147 @@
 #!/usr/bin/env python3
-"""The web page in a real headless Chromium (WebGPU on SwiftShader), driven over WebDriver by chromedriver: serves
-target/web (scripts/web/build.sh), opens the page for a scene and estimator, waits until it has N spp, and checks
-the image's mean radiance against the native renderer's (the `mislab` Python package, same scene, settings, seed and
-size) within 3 %; then the same for a second estimator, whose image must differ from the first. Fails —
-never skips — when the page reports no WebGPU adapter. Standard library only; a screenshot goes to --screenshot.
+"""The web page in a real headless Chromium (WebGPU on SwiftShader), used as a person would, over WebDriver
+(scripts/web/webdriver.py): it serves target/web (scripts/web/build.sh) and
+
+ 1. opens a built-in scene, waits for N spp, saves the image with the panel's "Save EXR" (a browser download) and
+    compares it in distribution with the native renderer's image of the same scene, settings and seed (the `mislab`
+    Python package): no further from it than a second native render of another seed is, and the same mean;
+ 2. switches the strategy by clicking its radio button: the status says so, the samples restart, and the new image
+    matches its own native render and differs from the first;
+ 3. turns on the A | B comparison (a click): side B renders with its strategy and its native mean;
+ 4. shows the standard-error view (a click);
+ 5. drops a glTF scene (.gltf + .bin) and a Mitsuba scene (its XML, included fragments and OBJ meshes, dropped
+    without their folders) on the canvas: each renders with its native mean.
+It fails — never skips — when the page reports no WebGPU adapter. Screenshots go to target/web-test-*.png.
 
   python3 scripts/web/test_page.py --python target/ci-venv/bin/python
 """
 import argparse
-import base64
 import json
 import os
-import re
-import socket
 import subprocess
 import sys
 import time
-import urllib.request
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from webdriver import Page  # noqa: E402
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+SHARED = os.path.join(ROOT, "..", "shared")
 
 p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-p.add_argument("--web", default="target/web", help="the built page")
-p.add_argument("--python", default=sys.executable, help="a Python with the mislab package (for the native means)")
+p.add_argument("--web", default=os.path.join(ROOT, "target/web"), help="the built page")
+p.add_argument("--python", default=sys.executable, help="a Python with the mislab package (for the native images)")
 p.add_argument("--chromium", default="/usr/bin/chromium")
 p.add_argument("--chromedriver", default="/usr/bin/chromedriver")
-p.add_argument("--spp", type=int, default=64)
+p.add_argument("--spp", type=int, default=8)
 p.add_argument("--timeout", type=float, default=600, help="seconds a page may take to reach --spp")
-p.add_argument("--screenshot", default="target/web-test.png")
-p.add_argument("--scene", default="veach-mis")
+p.add_argument("--screenshots", default=os.path.join(ROOT, "target/web-test"))
 a = p.parse_args()
-CASES = ((a.scene, "mis"), (a.scene, "uniform"))
 
-# Chromium's WebGPU on SwiftShader, headless (issue 45); no network, no first-run chores.
-FLAGS = ["--headless=new", "--no-sandbox", "--enable-unsafe-webgpu", "--enable-features=Vulkan",
-         "--use-vulkan=swiftshader", "--use-angle=swiftshader", "--disable-gpu-sandbox", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync", "--disable-quic",
-         "--window-size=1200,700"]
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def call(method, url, body=None):
-    data = None if body is None else json.dumps(body).encode()
-    req = urllib.request.Request(url, data=data, method=method, headers={"Content-Type": "application/json"})
-    with urllib.request.urlopen(req, timeout=120) as r:
-        return json.loads(r.read())["value"]
-
-
-def native_mean(scene, strategy):
-    code = (
-        "import mislab, numpy as np\n"
-        f"img = mislab.render({scene!r}, strategy={strategy!r}, spp={a.spp}, width=320, height=240)\n"
-        "print(float(np.asarray(img.mean).mean()))\n"
-    )
-    out = subprocess.run([a.python, "-c", code], capture_output=True, text=True)
-    if out.returncode != 0:
-        sys.exit(f"FAIL: the native render failed:\n{out.stderr}")
-    return float(out.stdout.split()[-1])
-
-
-web_port, driver_port = free_port(), free_port()
-server = subprocess.Popen([sys.executable, "-m", "http.server", str(web_port), "-d", a.web, "--bind", "127.0.0.1"],
-                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-driver = subprocess.Popen([a.chromedriver, f"--port={driver_port}"], stdout=subprocess.DEVNULL,
-                          stderr=subprocess.DEVNULL)
-base = f"http://127.0.0.1:{driver_port}"
 failures = []
+# What the native side renders and compares, filled as the page goes: one dict per image.
+checks = []
+
+
+def at_least(key, n, **equal):
+    return lambda f: int(f.get(key, 0)) >= n and all(f.get(k) == v for k, v in equal.items())
+
+
+page = Page(a.web, a.chromium, a.chromedriver)
 try:
-    for _ in range(50):
-        try:
-            call("GET", f"{base}/status")
-            break
-        except OSError:
-            time.sleep(0.2)
-    caps = {"capabilities": {"alwaysMatch": {"browserName": "chrome", "goog:loggingPrefs": {"browser": "ALL"},
-                                             "goog:chromeOptions": {
-        "binary": a.chromium, "args": FLAGS + [f"--user-data-dir=/tmp/mislab-web-{os.getpid()}"]}}}}
-    session = call("POST", f"{base}/session", caps)["sessionId"]
-    s = f"{base}/session/{session}"
-    results = {}
-    for scene, strategy in CASES:
-        url = f"http://127.0.0.1:{web_port}/?scene={scene}&strategy={strategy}&spp={a.spp}"
-        call("POST", f"{s}/url", {"url": url})
-        t0, status = time.time(), ""
-        while time.time() - t0 < a.timeout:
-            status = call("POST", f"{s}/execute/sync",
-                          {"script": "return document.getElementById('status').textContent", "args": []})
-            if status.startswith(("error", "mislab panicked")) or re.search(r"spp=(\d+)", status) and \
-                    int(re.search(r"spp=(\d+)", status).group(1)) >= a.spp:
-                break
-            time.sleep(1)
-        seconds = time.time() - t0
-        print(f"{scene} {strategy}: '{status}' after {seconds:.1f} s")
-        for entry in call("POST", f"{s}/se/log", {"type": "browser"}):
-            if entry.get("level") in ("SEVERE", "WARNING") and "favicon" not in entry.get("message", ""):
-                print(f"  browser console: {entry.get('message', '')[:2000]}")
-        if status.startswith(("error", "mislab panicked")) or "spp=" not in status:
-            failures.append(f"{scene} {strategy}: the page never rendered ({status!r}); no WebGPU adapter?")
-            continue
-        spp = int(re.search(r"spp=(\d+)", status).group(1))
-        if spp < a.spp:
-            failures.append(f"{scene} {strategy}: {spp} of {a.spp} spp in {a.timeout} s")
-            continue
-        web = float(re.search(r"mean=([0-9.eE+-]+)", status).group(1))
-        native = native_mean(scene, strategy)
-        results[strategy] = web
-        rel = abs(web - native) / max(native, 1e-9)
-        print(f"  mean radiance: web {web:.6f}, native {native:.6f} ({100 * rel:.2f} % apart); "
-              f"{spp / seconds:.1f} spp/s at 320×240 in the browser")
-        if rel > 0.03:
-            failures.append(f"{scene} {strategy}: web mean {web} vs native {native}")
-        png = call("GET", f"{s}/screenshot")
-        with open(a.screenshot.replace(".png", f"-{strategy}.png"), "wb") as f:
-            f.write(base64.b64decode(png))
-    if len(results) == 2 and results["mis"] == results["uniform"]:
-        # Switching the estimator must change the image (each matched its own native render above).
-        failures.append(f"mis and uniform gave the same image: {results}")
-    call("DELETE", s)
+    t_open = time.time()
+    page.open(f"scene=veach-mis&strategy=mis&spp={a.spp}")
+    f, secs = page.wait("veach-mis, MIS", at_least("spp", a.spp, strategy="mis"), a.timeout)
+    print(f"1. veach-mis MIS: {f['spp']} spp after {secs:.1f} s (page opened to image), mean {f['mean']}, "
+          f"{float(f['samples_per_s']) / 1e6:.3f} M samples/s")
+    page.click("save-exr")
+    exr = page.downloaded(f"veach-mis-mis-{f['spp']}spp.exr")
+    checks.append({"what": "veach-mis MIS (downloaded EXR)", "scene": "veach-mis", "strategy": "mis",
+                   "spp": int(f["spp"]), "web_mean": float(f["mean"]), "exr": exr})
+    page.screenshot(f"{a.screenshots}-mis.png")
+
+    page.click("strategy:uniform")
+    f, secs = page.wait("the click on 'uniform'", at_least("spp", a.spp, strategy="uniform"), a.timeout)
+    print(f"2. clicked uniform: {f['spp']} spp after {secs:.1f} s, mean {f['mean']}")
+    page.click("save-exr")
+    exr_uniform = page.downloaded(f"veach-mis-uniform-{f['spp']}spp.exr")
+    checks.append({"what": "veach-mis uniform (after a click)", "scene": "veach-mis", "strategy": "uniform",
+                   "spp": int(f["spp"]), "web_mean": float(f["mean"]), "exr": exr_uniform, "differs_from": exr})
+
+    page.click("compare")
+    f, secs = page.wait("the A | B comparison", at_least("spp_b", a.spp, strategy_b="bsdf"), a.timeout)
+    print(f"3. compare A | B: A {f['strategy']} mean {f['mean']}, B {f['strategy_b']} mean {f['mean_b']} "
+          f"({secs:.1f} s)")
+    checks.append({"what": "veach-mis side B (bsdf)", "scene": "veach-mis", "strategy": "bsdf",
+                   "spp": int(f["spp_b"]), "web_mean": float(f["mean_b"])})
+    page.screenshot(f"{a.screenshots}-compare.png")
+
+    page.click("view:std-error")
+    f, _ = page.wait("the std-error view", lambda f: f.get("view") == "std-error", 60)
+    time.sleep(2)
+    page.screenshot(f"{a.screenshots}-std-error.png")
+    print(f"4. view {f['view']}")
+    page.click("view:image")
+    page.click("compare")
+
+    cbox = os.path.join(SHARED, "scenes/cornell-box")
+    page.drop([os.path.join(cbox, "cbox.gltf"), os.path.join(cbox, "cbox.bin")])
+    f, secs = page.wait("the dropped glTF", at_least("spp", a.spp, scene="cbox.gltf"), a.timeout)
+    print(f"5. dropped cbox.gltf + cbox.bin: {f['spp']} spp after {secs:.1f} s, mean {f['mean']}")
+    checks.append({"what": "dropped glTF", "scene": os.path.join(cbox, "cbox.gltf"), "strategy": f["strategy"],
+                   "spp": int(f["spp"]), "web_mean": float(f["mean"])})
+    page.screenshot(f"{a.screenshots}-dropped-gltf.png")
+
+    mitsuba = os.path.join(SHARED, "testdata/scenes/mitsuba-data/cbox")
+    files = [os.path.join(mitsuba, "cbox-rgb.xml")]
+    files += [os.path.join(mitsuba, "fragments", n) for n in ("base.xml", "bsdfs-rgb.xml", "shapes.xml")]
+    files += [os.path.join(mitsuba, "meshes", n) for n in sorted(os.listdir(os.path.join(mitsuba, "meshes")))]
+    page.drop(files)
+    f, secs = page.wait("the dropped Mitsuba scene", at_least("spp", a.spp, scene="cbox-rgb.xml"), a.timeout)
+    print(f"   dropped cbox-rgb.xml with {len(files) - 1} fragments and meshes: {f['spp']} spp after {secs:.1f} s, "
+          f"mean {f['mean']}")
+    checks.append({"what": "dropped Mitsuba XML", "scene": os.path.join(mitsuba, "cbox-rgb.xml"),
+                   "strategy": f["strategy"], "spp": int(f["spp"]), "web_mean": float(f["mean"])})
+    page.screenshot(f"{a.screenshots}-dropped-mitsuba.png")
+    page.console()
 finally:
-    driver.terminate()
-    server.terminate()
+    page.close()
+
+# The native side: the same scenes, settings and seeds on this machine's Vulkan driver.
+NATIVE = r"""
+import json, sys, numpy as np, mislab
+out = []
+for c in json.loads(sys.argv[1]):
+    kw = dict(strategy=c["strategy"], spp=c["spp"], width=320, height=240)
+    native = mislab.render(c["scene"], **kw)
+    r = {"native_mean": float(np.asarray(native.mean).mean())}
+    if "exr" in c:
+        other_seed = mislab.render(c["scene"], seed=7, **kw)
+        r["web_vs_native"] = mislab.compare(c["exr"], native)["relmse"]
+        r["seed_vs_native"] = mislab.compare(other_seed, native)["relmse"]
+    if "differs_from" in c:
+        r["vs_first"] = mislab.compare(c["exr"], c["differs_from"])["relmse"]
+    out.append(r)
+print(json.dumps(out))
+"""
+run = subprocess.run([a.python, "-c", NATIVE, json.dumps(checks)], capture_output=True, text=True)
+if run.returncode != 0:
+    sys.exit(f"FAIL: the native renders failed:\n{run.stderr}")
+for c, r in zip(checks, json.loads(run.stdout.splitlines()[-1])):
+    rel = abs(c["web_mean"] - r["native_mean"]) / max(r["native_mean"], 1e-9)
+    line = f"{c['what']}: mean web {c['web_mean']:.6f}, native {r['native_mean']:.6f} ({100 * rel:.3f} % apart)"
+    if rel > 0.02:
+        failures.append(line)
+    if "web_vs_native" in r:
+        line += (f"; block relMSE web vs native {r['web_vs_native']:.2e}, "
+                 f"another native seed vs native {r['seed_vs_native']:.2e}")
+        if not r["web_vs_native"] <= r["seed_vs_native"]:
+            failures.append(f"{c['what']}: the page's image is further from the native one than noise: {r}")
+    if "vs_first" in r:
+        line += f"; relMSE against the first estimator's image {r['vs_first']:.2e}"
+        if not r["vs_first"] > r["web_vs_native"] * 10:
+            failures.append(f"{c['what']}: switching the estimator did not change the image: {r}")
+    print(line)
 
 if failures:
     sys.exit("FAIL:\n  " + "\n  ".join(failures))
