@@ -65,6 +65,7 @@ fn pbrt_with_meshes_and_textures() {
 #[test]
 fn mitsuba_with_includes_and_meshes() {
     same_from_memory(&shared("testdata/scenes/mitsuba-data/cbox"), "cbox.xml");
+    same_from_memory(&shared("testdata/scenes/mitsuba-data/cbox"), "cbox-rgb.xml");
 }
 
 #[test]

@@ -113,53 +113,12 @@ impl Job {
             }
         }
         let file = &scene.scene().file_settings;
-        if let Some((depth, source)) = &file.max_depth {
-            // The file's integrator fills the mode and the depth each where not given (--max-depth 17 alone
-            // still path traces, as the file asks; --mode direct alone ignores the file's depth).
-            let mut taken = Vec::new();
-            if !given("mode") {
-                self.settings.mode = Mode::Path;
-                taken.push("--mode path".to_string());
-            }
-            if self.settings.mode == Mode::Path && !given("max_depth") {
-                self.settings.max_depth = *depth;
-                taken.push(format!("--max-depth {depth}"));
-            }
-            if !taken.is_empty() {
-                notes.push(format!(
-                    "{} from the scene file ({source}; --mode/--max-depth override it)",
-                    taken.join(" ")
-                ));
-            }
-        }
-        if let Some((f, source)) = &file.filter {
-            if !given("filter") && !given("filter_radius") && !given("filter_sigma") {
-                if let Ok(shape) = f.shape.parse::<PixelFilter>() {
-                    self.settings.filter = shape;
-                    self.settings.filter_radius = Some(f.radius);
-                    self.settings.filter_sigma = f.sigma;
-                    notes.push(format!(
-                        "{} from the scene file ({source}; --filter/--filter-radius/--filter-sigma override it)",
-                        super::report::filter_flags(f)
-                    ));
-                }
-            }
-        }
-        if let Some((name, source)) = &file.sampler {
-            // Taken only where it can render the sample count asked, or else the file's (stratified has a maximum).
-            let spp = match self.budget {
-                Budget::Samples(n) if given("spp") => Some(n),
-                _ => file.spp.as_ref().map(|(n, _)| *n),
-            };
-            let fits = |s: SamplerKind| spp.is_none_or(|n| check_spp(s, n).is_ok());
-            match name.parse::<SamplerKind>() {
-                Ok(s) if !given("sampler") && fits(s) => {
-                    self.settings.sampler = s;
-                    notes.push(format!("--sampler {s} from the scene file ({source}; --sampler overrides it)"));
-                }
-                _ => {}
-            }
-        }
+        // The sample count the sampler must fit: the one asked for, or else the file's.
+        let spp = match self.budget {
+            Budget::Samples(n) if given("spp") => Some(n),
+            _ => file.spp.as_ref().map(|(n, _)| *n),
+        };
+        notes.extend(take_file_settings(&mut self.settings, file, &given, spp));
         if let Some((spp, source)) = &file.spp {
             if !given("spp") && !given("time") && self.session.is_none() {
                 let used = check_spp(self.settings.sampler, *spp).unwrap_or(*spp);
@@ -218,4 +177,57 @@ fn non_default_settings(settings: &Settings) -> Vec<String> {
 /// A state file whose header this mislab cannot use.
 fn invalid_state(path: &Path, problem: String) -> ApiError {
     StateError::Invalid { file: path.display().to_string(), problem }.into()
+}
+
+/// Takes the render settings a scene file states (path tracing and its depth, the pixel filter, the sampler where
+/// it fits `spp` samples) into `settings` where `given` says the user did not set them; a note per setting taken.
+/// `Job::resolve` for a render, and any front end that opens scene files (the web page) for its own settings.
+pub fn take_file_settings(
+    settings: &mut Settings,
+    file: &crate::scene::FileSettings,
+    given: &dyn Fn(&str) -> bool,
+    spp: Option<u32>,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if let Some((depth, source)) = &file.max_depth {
+        // The file's integrator fills the mode and the depth each where not given (--max-depth 17 alone
+        // still path traces, as the file asks; --mode direct alone ignores the file's depth).
+        let mut taken = Vec::new();
+        if !given("mode") {
+            settings.mode = Mode::Path;
+            taken.push("--mode path".to_string());
+        }
+        if settings.mode == Mode::Path && !given("max_depth") {
+            settings.max_depth = *depth;
+            taken.push(format!("--max-depth {depth}"));
+        }
+        if !taken.is_empty() {
+            notes.push(format!("{} from the scene file ({source}; --mode/--max-depth override it)", taken.join(" ")));
+        }
+    }
+    if let Some((f, source)) = &file.filter {
+        if !given("filter") && !given("filter_radius") && !given("filter_sigma") {
+            if let Ok(shape) = f.shape.parse::<PixelFilter>() {
+                settings.filter = shape;
+                settings.filter_radius = Some(f.radius);
+                settings.filter_sigma = f.sigma;
+                notes.push(format!(
+                    "{} from the scene file ({source}; --filter/--filter-radius/--filter-sigma override it)",
+                    super::report::filter_flags(f)
+                ));
+            }
+        }
+    }
+    if let Some((name, source)) = &file.sampler {
+        // Taken only where it can render the sample count asked, or else the file's (stratified has a maximum).
+        let fits = |s: SamplerKind| spp.is_none_or(|n| check_spp(s, n).is_ok());
+        match name.parse::<SamplerKind>() {
+            Ok(s) if !given("sampler") && fits(s) => {
+                settings.sampler = s;
+                notes.push(format!("--sampler {s} from the scene file ({source}; --sampler overrides it)"));
+            }
+            _ => {}
+        }
+    }
+    notes
 }

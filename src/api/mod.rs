@@ -31,7 +31,7 @@ pub use drive::{drive, Plan, SaveCheckpoint, TARGET_SUBMIT_SECONDS};
 pub use error::ApiError;
 pub use flags::{scene_spec, FlagInfo, RenderFlags, DEFAULT_SPP};
 pub use image::{header_attributes, Image};
-pub use job::Job;
+pub use job::{take_file_settings, Job};
 pub use lab::Lab;
 pub use merge::merge;
 pub use observer::{Callbacks, Observer, Progress, Unobserved};

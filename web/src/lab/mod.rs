@@ -193,6 +193,16 @@ impl WebLab {
             Err(e) => return self.error = Some(e.to_string()),
         };
         self.notes = scene.warnings.clone();
+        // What the file says of its rendering (a Mitsuba <integrator type="path">, pbrt's Integrator, a filter or
+        // sampler) becomes both sides' settings, as `mislab render` takes it; the panel changes them after.
+        for s in &mut self.settings {
+            let taken = mislab::api::take_file_settings(s, &scene.file_settings, &|_| false, None);
+            for note in taken {
+                if !self.notes.contains(&note) {
+                    self.notes.push(note);
+                }
+            }
+        }
         match GpuScene::upload(&self.ctx, SceneData::build(&scene)) {
             Ok(gs) => self.scene = Some((gs, scene.camera.clone())),
             Err(e) => return self.error = Some(format!("{}: {e}", self.scene_name)),
@@ -495,7 +505,8 @@ impl WebLab {
             );
         }
         line += &format!(
-            " view={} nonfinite_px={} samples_per_s={:.0}",
+            " mode={} view={} nonfinite_px={} samples_per_s={:.0}",
+            self.settings[0].mode.name(),
             self.view.name(),
             self.shown.stats[0].nonfinite_px,
             self.rate.per_s
