@@ -55,9 +55,11 @@ for row in rows:
         sys.exit(f"FAIL: the native viewer: {' '.join(cmd)}\n{run.stderr[-3000:]}")
     row["native"] = float(m.group(2)) * 1e6
     row["native_spp"] = m.group(1)
+    print(f"{row['scene']}: page {row['web'] / 1e6:.3f} M samples/s, native viewer {row['native'] / 1e6:.3f}",
+          flush=True)
 
-device = subprocess.run(["vulkaninfo", "--summary"], capture_output=True, text=True).stdout
-driver = re.search(r"driverInfo\s*=\s*(.*)", device)
+info = subprocess.run([a.mislab, "info"], capture_output=True, text=True).stdout
+driver = re.search(r"chosen adapter: (.*)", info)
 print(f"\n{a.width}×{a.height}, {a.strategy}, default settings; page: headless Chromium, WebGPU on SwiftShader; "
       f"viewer: Xvfb, {driver.group(1).strip() if driver else 'the default Vulkan driver'}; "
       f"{time.strftime('%Y-%m-%d')}\n")

@@ -95,6 +95,10 @@ pub struct WebLab {
     notes: Vec<String>,
     error: Option<String>,
     controls: Vec<(String, egui::Rect)>,
+    /// Frames the page has drawn, and when the last one began (the status line's frame time).
+    frames: u64,
+    frame_ms: f64,
+    last_frame_s: f64,
 }
 
 fn strategy_name(s: Strategy) -> &'static str {
@@ -167,6 +171,9 @@ impl WebLab {
             notes: Vec::new(),
             error: None,
             controls: Vec::new(),
+            frames: 0,
+            frame_ms: 0.0,
+            last_frame_s: page::now_s(),
         };
         lab.load_scene();
         Ok(lab)
@@ -505,11 +512,13 @@ impl WebLab {
             );
         }
         line += &format!(
-            " mode={} view={} nonfinite_px={} samples_per_s={:.0}",
+            " mode={} view={} nonfinite_px={} samples_per_s={:.0} frames={} frame_ms={:.0}",
             self.settings[0].mode.name(),
             self.view.name(),
             self.shown.stats[0].nonfinite_px,
-            self.rate.per_s
+            self.rate.per_s,
+            self.frames,
+            self.frame_ms
         );
         line
     }
@@ -518,10 +527,13 @@ impl WebLab {
 impl eframe::App for WebLab {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        let now = page::now_s();
+        self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - self.last_frame_s) * 1e3;
+        (self.frames, self.last_frame_s) = (self.frames + 1, now);
         self.inbox.accept_dropped(ctx.input(|i| i.raw.dropped_files.clone()));
         self.advance(&ctx);
         self.controls.clear();
-        egui::Panel::left("mislab-panel").default_size(250.0).resizable(false).show(ui, |ui| {
+        egui::Panel::left("mislab-panel").default_size(290.0).resizable(false).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
         });
         egui::CentralPanel::default().show(ui, |ui| self.image_area(ui));
