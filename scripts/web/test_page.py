@@ -2,9 +2,10 @@
 """The web page in a real headless Chromium (WebGPU on SwiftShader), used as a person would, over WebDriver
 (scripts/web/webdriver.py): it serves target/web (scripts/web/build.sh) and
 
- 1. opens a built-in scene, waits for N spp, saves the image with the panel's "Save EXR" (a browser download) and
-    compares it in distribution with the native renderer's image of the same scene, settings and seed (the `mislab`
-    Python package): no further from it than a second native render of another seed is, and the same mean;
+ 1. opens a built-in scene, waits for N spp, saves the image with the panel's "Save PNG" and "Save EXR" (browser
+    downloads) and compares the EXR in distribution with the native renderer's image of the same scene, settings
+    and seed (the `mislab` Python package): no further from it than a second native render of another seed is, and
+    the same mean;
  2. switches the strategy by clicking its radio button: the status says so, the samples restart, and the new image
     matches its own native render and differs from the first;
  3. turns on the A | B comparison (a click): side B renders with its strategy and its native mean;
@@ -58,6 +59,11 @@ try:
     exr = page.downloaded(f"veach-mis-mis-{f['spp']}spp.exr")
     checks.append({"what": "veach-mis MIS (downloaded EXR)", "scene": "veach-mis", "strategy": "mis",
                    "spp": int(f["spp"]), "web_mean": float(f["mean"]), "exr": exr})
+    page.click("save-png")
+    png = open(page.downloaded(f"veach-mis-mis-{f['spp']}spp.png"), "rb").read()
+    width, height = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+    if png[:8] != b"\x89PNG\r\n\x1a\n" or (width, height) != (320, 240):
+        failures.append(f"Save PNG: not a 320×240 PNG ({png[:8]!r}, {width}×{height})")
     page.screenshot(f"{a.screenshots}-mis.png")
 
     page.click("strategy:uniform")
