@@ -53,7 +53,9 @@ pub fn load_envmap(path: &Path) -> Result<(EnvMap, Vec<String>), SceneError> {
         if len > limit {
             return Err(too_large(len));
         }
-        check_size_and_header(&file_head(&file).map_err(err)?, len, format).map_err(err)?;
+        // Only a Radiance file's header is looked at: an EXR is not read twice.
+        let head = if format == image::ImageFormat::Hdr { file_head(&file).map_err(err)? } else { Vec::new() };
+        check_size_and_header(&head, len, format).map_err(err)?;
         super::catch_quietly(|| decode(path, BufReader::new(file), format))
     };
     decoded.unwrap_or_else(|panic| Err(err(format!("corrupt {} file (the decoder failed: {panic})", name(format)))))

@@ -101,10 +101,6 @@ pub struct WebLab {
     last_frame_s: f64,
 }
 
-fn strategy_name(s: Strategy) -> &'static str {
-    s.name()
-}
-
 impl WebLab {
     pub fn new(cc: &eframe::CreationContext<'_>) -> Result<WebLab, String> {
         let rs = cc.wgpu_render_state.as_ref().ok_or("eframe started without wgpu")?;
@@ -116,14 +112,14 @@ impl WebLab {
             |k: &str, d: u32| get(k).and_then(|v| v.parse().ok()).filter(|n| (16..=1920).contains(n)).unwrap_or(d);
         let (width, height) = (size("width", 320), size("height", 240));
         let mut a = Settings { width, height, strategy: Strategy::Mis, ..Settings::default() };
-        if let Some(s) = get("strategy").and_then(|v| STRATEGIES.iter().find(|s| strategy_name(**s) == v)) {
+        if let Some(s) = get("strategy").and_then(|v| STRATEGIES.iter().find(|s| s.name() == v)) {
             a.strategy = *s;
         }
         if get("mode") == Some("path") {
             a.mode = Mode::Path;
         }
         let mut b = Settings { strategy: Strategy::Bsdf, ..a.clone() };
-        let compare = match get("compare").and_then(|v| STRATEGIES.iter().find(|s| strategy_name(**s) == v)) {
+        let compare = match get("compare").and_then(|v| STRATEGIES.iter().find(|s| s.name() == v)) {
             Some(s) => {
                 b.strategy = *s;
                 true
