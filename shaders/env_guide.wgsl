@@ -64,13 +64,21 @@ fn env_guide_alpha(slot: u32) -> f32 {
     return guide_cdf[slot * GUIDE_BINS + GUIDE_BINS - 1u];
 }
 
-/// The guide's slot for a receiver, or INVALID where the cosine alone is used (not guided, no guide learned yet,
-/// no normal, or a slot without counts).
-fn env_guided_slot(p: vec3<f32>, n: vec3<f32>) -> u32 {
-    if (cfg_env_sampling() != ENV_SAMPLING_GUIDED || params.guide_on == 0u || !env_cosine(n)) { return INVALID; }
+/// The guide at a receiver: its slot and the slot's guide probability alpha (`env_guide_alpha`), read once.
+struct GuideAt {
+    slot: u32,
+    alpha: f32,
+}
+
+/// The guide at a receiver at p with normal n; slot INVALID (alpha 0) where the cosine alone is used (not guided,
+/// no guide learned yet, no normal, or a slot without counts).
+fn env_guide_at(p: vec3<f32>, n: vec3<f32>) -> GuideAt {
+    let none = GuideAt(INVALID, 0.0);
+    if (cfg_env_sampling() != ENV_SAMPLING_GUIDED || params.guide_on == 0u || !env_cosine(n)) { return none; }
     let slot = env_guide_slot(p, n);
-    if (!(env_guide_alpha(slot) > 0.0)) { return INVALID; }
-    return slot;
+    let alpha = env_guide_alpha(slot);
+    if (!(alpha > 0.0)) { return none; }
+    return GuideAt(slot, alpha);
 }
 
 /// The guide's density (solid angle) of direction bin b in `slot` (the last bin's CDF entry is 1).

@@ -354,15 +354,12 @@ struct DirectionSample {
 /// included).
 fn direction_mis_weight(s: DirectionSample, found: Found) -> f32 {
     if (!mis_on()) { return 1.0; }
-    var p_light = 0.0;
-    if (found.light == params.env_light) {
-        p_light = env_pdf(s.w, s.p, env_receiver(s.n, s.transmits));
-    } else {
-        var m = s.light;
-        if (!light_measure_known()) { m = light_measure(found.light, s.p); }
-        // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
-        p_light = light_pdf_li(found.light, m, s.p, env_receiver(s.n, s.transmits), s.w, found.surface.p, found.surface.ng);
-    }
+    var m = s.light;
+    if (!light_measure_known() && found.light != params.env_light) { m = light_measure(found.light, s.p); }
+    // One light_pdf_li for every kind, the environment included: each call site is compiled with all it reaches.
+    // y.ng was flipped towards the ray; |cos| is what the area conversion needs.
+    let p_light = light_pdf_li(found.light, m, s.p, env_receiver(s.n, s.transmits), s.w, found.surface.p,
+                               found.surface.ng);
     // A convex lamp's face was found: the lamp is what light sampling chooses.
     let chosen = chosen_light(found.light);
     return mis_weight(f32(params.bsdf_samples), s.pdf, f32(params.light_samples), light_pmf(chosen, s.p, s.n) * p_light);
@@ -410,7 +407,7 @@ struct Plan {
 /// Whether the environment guide draws the sky samples at c (a constant sky, guided, and c's slot learned).
 fn first_hit_guided(c: ShadingCtx) -> bool {
     if (ENV_KIND == 0u) { return false; }
-    return env_guided_slot(c.x.p, env_receiver(c.x.ns, bsdf_transmits(c.brdf))) != INVALID;
+    return env_guide_at(c.x.p, env_receiver(c.x.ns, bsdf_transmits(c.brdf))).slot != INVALID;
 }
 
 fn strategy_plan(c: ShadingCtx) -> Plan {

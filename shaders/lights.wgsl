@@ -659,9 +659,9 @@ fn env_pdf(w: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
     if (env_cosine(n)) {
         // Below the surface the density is 0 whatever the guide holds: `env_sample` drops the guide's samples there.
         let cosine = max(dot(w, n), 0.0) * INV_PI;
-        let slot = env_guided_slot(p, n);
-        if (slot == INVALID || !(cosine > 0.0)) { return cosine; }
-        return env_guided_pdf(slot, env_guide_alpha(slot), env_guide_bin(w), cosine);
+        let g = env_guide_at(p, n);
+        if (g.slot == INVALID || !(cosine > 0.0)) { return cosine; }
+        return env_guided_pdf(g.slot, g.alpha, env_guide_bin(w), cosine);
     }
     if (env_uniform()) { return INV_FOUR_PI; }
     let uv = env_direction_to_uv(w);
@@ -677,25 +677,24 @@ fn env_pdf(w: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
 /// differ on that measure-zero set. Measure: solid angle.
 fn env_sample(u: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     if (env_cosine(n)) {
-        let slot = env_guided_slot(p, n);
+        let g = env_guide_at(p, n);
         var wi: vec3<f32>;
-        var pdf: f32;
-        var alpha = 0.0;
-        if (slot != INVALID) { alpha = env_guide_alpha(slot); }
-        if (u.z < alpha) {
+        var b: u32;
+        if (u.z < g.alpha) {
             // The guide's share: its bins cover the whole sphere, so a direction below the surface is a lost sample.
-            let b = env_guide_pick(slot, u.z / alpha);
+            b = env_guide_pick(g.slot, u.z / g.alpha);
             wi = env_guide_bin_direction(b, u.xy);
-            let cosine = dot(wi, n);
-            if (!(cosine > 0.0)) { return no_light_sample(); }
-            pdf = env_guided_pdf(slot, alpha, b, cosine * INV_PI);
         } else {
             let local = square_to_cosine_hemisphere(u.xy);
             if (!(local.z > 0.0)) { return no_light_sample(); }
             wi = to_world(frame_from_normal(n), local);
-            pdf = max(dot(wi, n), 0.0) * INV_PI;
-            if (slot != INVALID) { pdf = env_guided_pdf(slot, alpha, env_guide_bin(wi), pdf); }
+            b = env_guide_bin(wi);
         }
+        // One density for both shares (one guide lookup compiled, not two: lavapipe's start-up is its code's size).
+        let cosine = dot(wi, n);
+        if (!(cosine > 0.0)) { return no_light_sample(); }
+        var pdf = cosine * INV_PI;
+        if (g.slot != INVALID) { pdf = env_guided_pdf(g.slot, g.alpha, b, pdf); }
         if (!(pdf > 0.0)) { return no_light_sample(); }
         return LightSample(wi, F32_MAX, env_radiance(wi), pdf, LightMeasure(MEASURE_SOLID_ANGLE, 0.0), INVALID);
     }

@@ -150,8 +150,33 @@ pub fn quiet_device_select_layer() {
     });
 }
 
-fn vulkan_instance() -> wgpu::Instance {
+/// lavapipe (Mesa's software Vulkan) compiles a render kernel to 8-lane code by default on AVX2 CPUs, and on Mesa
+/// 25 that takes 2.8–3.3 s for a BVH scene's kernel, most of it in LLVM over code that grows with the lane count
+/// (every storage load is unrolled per lane). 4-lane code compiles in 1.6–1.9 s and renders as fast (within ±7 %,
+/// the same pixels; docs/performance.md, "Time to an image"). So where the user has not chosen a width, lavapipe is
+/// asked for 128-bit vectors through its documented `LP_NATIVE_VECTOR_WIDTH`, once, before this process makes any
+/// Vulkan call. Only lavapipe and llvmpipe read the variable: GPU drivers are unaffected.
+pub fn lavapipe_vector_width() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if std::env::var_os("LP_NATIVE_VECTOR_WIDTH").is_none() {
+            std::env::set_var("LP_NATIVE_VECTOR_WIDTH", LAVAPIPE_VECTOR_BITS);
+        }
+    });
+}
+
+/// The vector width (bits) `lavapipe_vector_width` asks lavapipe for.
+pub const LAVAPIPE_VECTOR_BITS: &str = "128";
+
+/// What this process sets in the environment before its first Vulkan call (`quiet_device_select_layer`,
+/// `lavapipe_vector_width`); every instance, the viewer's too, is made after it.
+pub fn prepare_driver_environment() {
     quiet_device_select_layer();
+    lavapipe_vector_width();
+}
+
+fn vulkan_instance() -> wgpu::Instance {
+    prepare_driver_environment();
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = wgpu::Backends::VULKAN;
     wgpu::Instance::new(desc)

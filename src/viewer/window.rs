@@ -334,7 +334,7 @@ pub fn run(args: ViewArgs) -> Result<(), ViewerError> {
     let (_, _, _) = config(&args, scene)?;
     let width = super::app::PANEL_WIDTH + 24.0 + args.width as f32;
     let height = (args.height as f32 + 20.0).max(760.0);
-    crate::gpu::quiet_device_select_layer();
+    crate::gpu::prepare_driver_environment();
     let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     setup.instance_descriptor.backends = wgpu::Backends::VULKAN;
     let options = eframe::NativeOptions {
