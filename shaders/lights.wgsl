@@ -688,7 +688,7 @@ fn env_sample(u: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> LightSample {
             let local = square_to_cosine_hemisphere(u.xy);
             if (!(local.z > 0.0)) { return no_light_sample(); }
             wi = to_world(frame_from_normal(n), local);
-            b = env_guide_bin(wi);
+            if (g.slot != INVALID) { b = env_guide_bin(wi); }
         }
         // One density for both shares (one guide lookup compiled, not two: lavapipe's start-up is its code's size).
         let cosine = dot(wi, n);
