@@ -43,6 +43,8 @@ const LIGHT_SAMPLING_SOLID_ANGLE: u32 = 1u;
 const ENV_SAMPLING_UNIFORM: u32 = 0u;
 const ENV_SAMPLING_IMPORTANCE: u32 = 1u;
 const ENV_SAMPLING_GUIDED: u32 = 2u;
+// Resolved on the host to guided or importance (src/render/sky_probe.rs): no kernel sees it.
+const ENV_SAMPLING_AUTO: u32 = 3u;
 
 const LIGHT_SELECT_UNIFORM: u32 = 0u;
 const LIGHT_SELECT_POWER: u32 = 1u;

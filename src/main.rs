@@ -271,6 +271,15 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
         stats.nonfinite
     );
+    if let (mislab::render::settings::EnvSampling::Auto, Some(p)) = (settings.env_sampling, image.sky_probe) {
+        eprintln!(
+            "env-sampling auto: {} (sky probe: the guide would draw {:.1} % of the first vertices' light samples; \
+             it is used from {:.0} %)",
+            if p.wants_guide() { "guided" } else { "importance" },
+            100.0 * p.guided_share,
+            100.0 * mislab::render::sky_probe::MIN_GUIDED_SHARE
+        );
+    }
     if let Some((guided, slots)) = image.guide_coverage {
         eprintln!("environment guide: {guided} of {slots} slots (region × normal) draw sky samples from it");
     }

@@ -464,7 +464,8 @@ fn camera_controls() {
     assert!((o.distance - 0.5 * d).abs() < 1e-4);
 }
 
-/// The viewer on a sky-lit room (tests/data/scenes/window_room.toml): under `env-sampling guided` (the default) a restart's first pass also learns the
+/// The viewer on a sky-lit room (tests/data/scenes/window_room.toml): under `env-sampling auto` (the default, which
+/// the sky probe makes guided here) a restart's first pass also learns the
 /// environment guide (`Renderer::ensure_guide`, called by the engine before a side's band); rendering goes on past
 /// it with no NaN/Inf, and after a settings change (here the mode, which resets the guide) likewise.
 #[test]
@@ -476,7 +477,8 @@ fn a_sky_lit_room_learns_its_guide_and_renders_on() {
     step_until(&mut h, "three samples per pixel", |s| s.stats[0].spp >= 3);
     {
         let s = h.state().engine().shared();
-        assert_eq!(s.stats[0].settings.env_sampling, EnvSampling::Guided, "guided is the default");
+        assert_eq!(s.stats[0].settings.env_sampling, EnvSampling::Auto, "auto is the default");
+        assert_eq!(s.stats[0].env_sampling, EnvSampling::Guided, "auto guides the room lit through a window");
         assert_eq!(s.stats[0].nonfinite_samples, 0, "NaN/Inf samples in the guided room");
         assert!(s.stats[0].image.mean_rel_se.is_some_and(f64::is_finite), "{:?}", s.stats[0].image);
     }

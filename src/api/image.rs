@@ -5,6 +5,7 @@ use super::budget::RenderStats;
 use super::error::ApiError;
 use crate::render::film::{Film, Tonemap};
 use crate::render::settings::Settings;
+use crate::render::sky_probe::SkyProbe;
 use crate::scene::SceneSpec;
 use std::path::Path;
 
@@ -23,6 +24,8 @@ pub struct Image {
     pub sample_range: (u32, u32),
     /// Of the environment guide's slots (region × normal), how many draw sky samples from it, where it is on.
     pub guide_coverage: Option<(usize, usize)>,
+    /// What the sky probe saw, where it ran (it decides `--env-sampling auto`; `settings` holds the choice).
+    pub sky_probe: Option<SkyProbe>,
 }
 
 impl Image {

@@ -36,5 +36,6 @@ pub fn merge(paths: &[PathBuf], state: Option<&Path>) -> Result<Image, ApiError>
         scene: SceneSpec::named(&h.scene),
         sample_range: (0, h.spp_total),
         guide_coverage: None,
+        sky_probe: None,
     })
 }

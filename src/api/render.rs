@@ -123,6 +123,7 @@ impl Render {
             scene: self.scene.clone(),
             sample_range: (self.first_sample, self.renderer.samples()),
             guide_coverage: self.renderer.guide_coverage(),
+            sky_probe: self.renderer.sky_probe(),
         })
     }
 }

@@ -25,6 +25,7 @@ pub mod settings;
 pub mod shader_prune;
 pub mod shaders;
 pub mod shading_data;
+pub mod sky_probe;
 pub mod tile_order;
 pub mod void_and_cluster;
 

@@ -17,6 +17,7 @@ use crate::render::render_module::{render_source, render_source_for};
 pub use crate::render::settings::RR_DEPTH;
 use crate::render::settings::{Mode, Settings};
 use crate::render::shaders;
+use crate::render::sky_probe::SkyProbe;
 use crate::render::tile_order::tile_row_stride;
 use crate::scene::Camera;
 
@@ -105,6 +106,9 @@ pub struct Renderer {
     guide_learner_period: Option<u32>,
     /// Whether the scene's environment is one constant (the only kind the guide serves).
     env_is_constant: bool,
+    /// What the sky probe saw from the camera the renderer was made with (`--env-sampling auto`); None where the
+    /// environment is not one constant or the probe cannot see the scene.
+    sky_probe: Option<SkyProbe>,
 }
 
 impl Renderer {
@@ -253,7 +257,12 @@ impl Renderer {
             guide_learner_period: None,
             guided_slots: 0,
             env_is_constant,
+            sky_probe: None,
         };
+        if env_is_constant {
+            r.sky_probe = r.probe_sky(d);
+        }
+        r.settings.env_sampling = r.resolved_env_sampling(r.settings.env_sampling);
         r.reset();
         Ok(r)
     }
@@ -409,7 +418,7 @@ impl Renderer {
         if settings.width != self.settings.width || settings.height != self.settings.height {
             return Err(RenderError::FilmSizeChange);
         }
-        self.settings = settings;
+        self.settings = Settings { env_sampling: self.resolved_env_sampling(settings.env_sampling), ..settings };
         self.reset();
         Ok(())
     }

@@ -94,8 +94,18 @@ settings_enum!(
         /// render's first sample — where the sky is visible from, per region and normal (through windows, say;
         /// src/render/env_guide.rs).
         Guided = 2 => "guided",
+        /// Guided where the camera's surfaces see little of a constant sky (inside a room), importance otherwise:
+        /// decided per view by a few thousand rays on the CPU (src/render/sky_probe.rs). The renderer resolves it
+        /// before compiling; its settings then hold the choice.
+        Auto = 3 => "auto",
     }
 );
+
+impl Default for EnvSampling {
+    fn default() -> Self {
+        Settings::default().env_sampling
+    }
+}
 
 settings_enum!(
     /// How one light is chosen among many.
@@ -264,7 +274,7 @@ impl Default for Settings {
             mode: Mode::Direct,
             strategy: Strategy::Mis,
             light_sampling: LightSampling::SolidAngle,
-            env_sampling: EnvSampling::Guided,
+            env_sampling: EnvSampling::Auto,
             light_select: LightSelect::Uniform,
             heuristic: Heuristic::Power,
             power_beta: 2.0,

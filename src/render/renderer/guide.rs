@@ -5,7 +5,9 @@ use super::Renderer;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{GpuContext, GpuError};
 use crate::render::env_guide;
+use crate::render::scene_data::SceneData;
 use crate::render::settings::{EnvSampling, Strategy};
+use crate::render::sky_probe::{self, SkyProbe};
 
 impl Renderer {
     /// Whether the settings sample the scene's environment by a guide (`--env-sampling guided`, a constant
@@ -15,6 +17,28 @@ impl Renderer {
         self.env_is_constant
             && s.env_sampling == EnvSampling::Guided
             && matches!(s.strategy, Strategy::Light | Strategy::Mis)
+    }
+
+    /// `--env-sampling auto` made concrete for this renderer's view: guided where the sky probe finds that the
+    /// guide would draw enough of the first vertices' light samples (or where it cannot probe a constant sky),
+    /// importance elsewhere. Other choices stand.
+    pub(super) fn resolved_env_sampling(&self, requested: EnvSampling) -> EnvSampling {
+        match (requested, self.sky_probe) {
+            (EnvSampling::Auto, Some(p)) if !p.wants_guide() => EnvSampling::Importance,
+            (EnvSampling::Auto, _) if self.env_is_constant => EnvSampling::Guided,
+            (EnvSampling::Auto, _) => EnvSampling::Importance,
+            (s, _) => s,
+        }
+    }
+
+    /// Traces the sky probe from this renderer's camera over `d`, the scene it renders.
+    pub(super) fn probe_sky(&self, d: &SceneData) -> Option<SkyProbe> {
+        sky_probe::probe_view(d, &self.camera, self.settings.width, self.settings.height)
+    }
+
+    /// What the sky probe saw (`--env-sampling auto`), where it ran.
+    pub fn sky_probe(&self) -> Option<SkyProbe> {
+        self.sky_probe
     }
 
     /// Once the environment guide is learned: how many of its slots (region × normal class) draw sky samples from

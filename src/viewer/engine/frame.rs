@@ -198,6 +198,7 @@ impl Engine {
             let r = &side.renderer;
             stats[i] = SideStats {
                 settings: self.settings[i].clone(),
+                env_sampling: r.settings().env_sampling,
                 generation: side.generation,
                 spp: r.samples(),
                 pass_rows: r.pass_row(),

@@ -7,7 +7,7 @@ use crate::gpu::GpuContext;
 use crate::render::display::ImageStats;
 use crate::render::display::View;
 use crate::render::film::Tonemap;
-use crate::render::settings::Settings;
+use crate::render::settings::{EnvSampling, Settings};
 use crate::scene::{Camera, Scene};
 use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -98,6 +98,8 @@ impl PipelineState {
 pub struct SideStats {
     /// Settings in force.
     pub settings: Settings,
+    /// How the renderer samples the environment: `settings.env_sampling` with `auto` resolved (`sky_probe`).
+    pub env_sampling: EnvSampling,
     /// Increments at every restart of the accumulation.
     pub generation: u64,
     /// Complete samples per pixel.
