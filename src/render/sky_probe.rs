@@ -12,7 +12,9 @@
 use crate::accel::bvh::reference::{self, Ray};
 use crate::accel::wide_bvh::GpuWideNode;
 use crate::accel::wide_node::WideChild;
-use crate::gpu::types::{GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE};
+use crate::gpu::types::{
+    make_prim, GpuQuad, GpuSphere, INVALID, PRIM_INDEX_MASK, PRIM_KIND_SHIFT, PRIM_QUAD, PRIM_SPHERE,
+};
 use crate::render::env_guide;
 use crate::render::scene_data::{SceneData, FLAT_MAX_PRIMS};
 use crate::scene::Camera;
@@ -152,8 +154,8 @@ impl Geometry<'_> {
             _ => (d.tri_verts.len() / 3) as u32,
         };
         (0..tris)
-            .chain((0..d.spheres.len() as u32).map(|i| (PRIM_SPHERE << PRIM_KIND_SHIFT) | i))
-            .chain((0..d.quads.len() as u32).map(|i| (PRIM_QUAD << PRIM_KIND_SHIFT) | i))
+            .chain((0..d.spheres.len() as u32).map(|i| make_prim(PRIM_SPHERE, i)))
+            .chain((0..d.quads.len() as u32).map(|i| make_prim(PRIM_QUAD, i)))
     }
 }
 
