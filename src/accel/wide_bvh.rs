@@ -316,6 +316,21 @@ pub fn build(tri_verts: &[[Vec3; 3]], spheres: &[GpuSphere], quads: &[GpuQuad], 
     })
 }
 
+/// The one BVH2 node a wide tree's [`Bvh`] keeps in `nodes`: an empty root (the binary traversal is not compiled
+/// into pipelines that use the wide tree).
+pub fn empty_bvh2_root() -> GpuBvhNode {
+    GpuBvhNode {
+        lmin: Aabb::EMPTY.min.into(),
+        l_first: EMPTY_CHILD,
+        lmax: Aabb::EMPTY.max.into(),
+        l_count: 0,
+        rmin: Aabb::EMPTY.min.into(),
+        r_first: EMPTY_CHILD,
+        rmax: Aabb::EMPTY.max.into(),
+        r_count: 0,
+    }
+}
+
 /// Collapses a BVH2 into the wide layout. The result is a [`Bvh`] whose `wide` holds the nodes (root first) and
 /// whose `prim_refs` are in the wide tree's leaf order; its `nodes` is a single empty BVH2 root (the binary
 /// traversal is not compiled into pipelines that use the wide tree). `None` if the wide tree would be deeper than
@@ -384,18 +399,8 @@ pub fn widen(bvh: &Bvh) -> Option<Bvh> {
         node.q_hi_yz = [pack(&bytes[5], 0), pack(&bytes[5], 1), pack(&bytes[6], 0), pack(&bytes[6], 1)];
         wide[dst] = node;
     }
-    let empty = GpuBvhNode {
-        lmin: Aabb::EMPTY.min.into(),
-        l_first: EMPTY_CHILD,
-        lmax: Aabb::EMPTY.max.into(),
-        l_count: 0,
-        rmin: Aabb::EMPTY.min.into(),
-        r_first: EMPTY_CHILD,
-        rmax: Aabb::EMPTY.max.into(),
-        r_count: 0,
-    };
     Some(Bvh {
-        nodes: vec![empty],
+        nodes: vec![empty_bvh2_root()],
         prim_refs: refs,
         wide,
         build_seconds: bvh.build_seconds + start.elapsed().as_secs_f64(),

@@ -10,7 +10,7 @@
 //! sees one whole file or the other (the last writer's pipelines win; the other's compile again next time).
 //! The file is bounded: past `MAX_BYTES` it is started afresh.
 
-use std::io::Write;
+use crate::io::cache_file;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -32,21 +32,7 @@ pub struct PipelineStore {
 /// What opening the store found, for the user to read: None when it loaded cleanly or there was nothing to load.
 pub type OpenNote = Option<String>;
 
-/// The directory mislab keeps caches in: `$XDG_CACHE_HOME/mislab`, else the platform's (`~/.cache/mislab` on
-/// Linux, `~/Library/Caches/mislab` on macOS, `%LOCALAPPDATA%\mislab` on Windows). None without a home.
-pub fn cache_dir() -> Option<PathBuf> {
-    let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
-    let base = env("XDG_CACHE_HOME").filter(|p| p.is_absolute()).or_else(|| {
-        if cfg!(target_os = "windows") {
-            env("LOCALAPPDATA")
-        } else if cfg!(target_os = "macos") {
-            env("HOME").map(|h| h.join("Library/Caches"))
-        } else {
-            env("HOME").map(|h| h.join(".cache"))
-        }
-    })?;
-    Some(base.join("mislab"))
-}
+pub use crate::io::cache_file::cache_dir;
 
 /// The cache file for `info`'s adapter and driver in `dir`, or None where the backend has no pipeline cache.
 pub fn file_for(dir: &Path, info: &wgpu::AdapterInfo) -> Option<PathBuf> {
@@ -60,34 +46,14 @@ pub fn file_for(dir: &Path, info: &wgpu::AdapterInfo) -> Option<PathBuf> {
     Some(dir.join(format!("{key}_{driver}.bin")))
 }
 
-/// `data` in the file's frame: magic, length, CRC-32, data.
+/// `data` in the file's frame: magic, length, CRC-32, data (`cache_file::frame`).
 pub fn frame(data: &[u8]) -> Vec<u8> {
-    let mut crc = flate2::Crc::new();
-    crc.update(data);
-    let mut out = Vec::with_capacity(data.len() + 20);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&(data.len() as u64).to_le_bytes());
-    out.extend_from_slice(&crc.sum().to_le_bytes());
-    out.extend_from_slice(data);
-    out
+    cache_file::frame(MAGIC, data)
 }
 
 /// The data inside a framed file, or why it cannot be used.
 pub fn unframe(file: &[u8]) -> Result<&[u8], &'static str> {
-    if file.len() < 20 || &file[..8] != MAGIC {
-        return Err("not a mislab pipeline cache (or an older format)");
-    }
-    let len = u64::from_le_bytes(file[8..16].try_into().unwrap());
-    let data = &file[20..];
-    if len != data.len() as u64 {
-        return Err("truncated");
-    }
-    let mut crc = flate2::Crc::new();
-    crc.update(data);
-    if crc.sum().to_le_bytes() != file[16..20] {
-        return Err("its checksum does not match (damaged)");
-    }
-    Ok(data)
+    cache_file::unframe(MAGIC, file)
 }
 
 impl PipelineStore {
@@ -151,22 +117,7 @@ impl PipelineStore {
         if data.len() == *saved {
             return Ok(());
         }
-        let dir = self.path.parent().unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir)?;
-        let tmp = dir.join(format!(
-            ".{}.{}.{:x}.tmp",
-            self.path.file_name().and_then(|n| n.to_str()).unwrap_or("cache"),
-            std::process::id(),
-            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos())
-        ));
-        let written = std::fs::File::create(&tmp).and_then(|mut f| {
-            f.write_all(&frame(&data))?;
-            f.sync_all()
-        });
-        if let Err(e) = written.and_then(|_| std::fs::rename(&tmp, &self.path)) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(e);
-        }
+        cache_file::write_atomically(&self.path, &frame(&data))?;
         *saved = data.len();
         Ok(())
     }

@@ -1,5 +1,6 @@
 //! Files in and out: opening inputs safely, writing outputs atomically, EXR images, and command-line values.
 
+pub mod cache_file;
 pub mod cli_values;
 pub mod error;
 pub mod exr_image;

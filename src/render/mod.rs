@@ -5,6 +5,7 @@
 
 pub mod baked;
 pub mod bindings;
+pub mod bvh_store;
 pub mod display;
 pub mod env_guide;
 pub mod error;

@@ -1,8 +1,8 @@
 //! SceneData: the scene flattened, on the CPU, into the tables the shaders read (geometry + BVH, shading
 //! data, light table, textures, environment distribution); `gpu_scene` uploads them.
 
+use crate::accel::bvh;
 use crate::accel::light_tree::GpuLightNode;
-use crate::accel::{bvh, wide_bvh};
 use crate::gpu::types::*;
 use crate::render::shading_data::{material_word, word_material, ShadingTable};
 use crate::scene::{Scene, TextureRef, Wrap};
@@ -92,7 +92,7 @@ pub struct SceneData {
     /// The 8-wide compressed BVH's nodes; empty where the scene uses the BVH2 (`bvh_nodes`). When not empty,
     /// `bvh_nodes` is one empty root and `prim_refs` follow the wide tree's leaves.
     pub wide_nodes: Vec<crate::accel::wide_bvh::GpuWideNode>,
-    /// BVH build time, seconds.
+    /// BVH build time, seconds (or the time to read it back from `render::bvh_store`).
     pub bvh_seconds: f64,
     /// BVH SAH cost.
     pub bvh_sah: f32,
@@ -239,7 +239,8 @@ impl SceneData {
         };
         let bvh_tris: Vec<[Vec3; 3]> = in_bvh.iter().map(|&i| tris[i]).collect();
         let presplit = if split.is_some() { bvh::Presplit::Off } else { presplit };
-        let mut bvh = wide_bvh::build(&bvh_tris, &d.spheres, &d.quads, presplit);
+        // Built, or read back from an earlier run's build of the same input (`bvh_store`).
+        let mut bvh = crate::render::bvh_store::build(&bvh_tris, &d.spheres, &d.quads, presplit);
         // Triangles in leaf order: traversal reads a triangle-only leaf's vertices without prim_refs. The baked
         // occluders follow the BVH's triangles.
         d.triangles = tris.len();
