@@ -24,6 +24,8 @@ use std::rc::Rc;
 use std::sync::Arc;
 
 mod film;
+mod lights;
+mod shape;
 mod textures;
 
 /// pbrt's world → mislab's when pbrt's camera frame is a proper rotation (a `LookAt`, say). pbrt's camera space
@@ -486,7 +488,7 @@ impl Parser {
                     self.b.ignore_at(format!("AreaLightSource \"{}\"", clip(kind, 40)), at(&p.file, p.line));
                 } else {
                     let l = self.spectrum(&p, "L", Vec3::ONE)?;
-                    let scale = light_scale(&p)?;
+                    let scale = lights::light_scale(&p)?;
                     let two_sided = p.bool("twosided", false)?;
                     if !(l * scale).is_finite() {
                         return Err(p.error("the area light's radiance × scale is out of the range of 32-bit floats"));
@@ -603,192 +605,6 @@ impl Parser {
         }
         Ok(())
     }
-
-    fn light(&mut self, kind: &str, p: &Params) -> Result<(), SceneError> {
-        let to_world = self.mirror * self.gs.ctm;
-        if !to_world.is_finite() || glam::DMat3::from_mat4(to_world).determinant() == 0.0 {
-            return Err(p.error("the light's transform is singular (determinant 0)"));
-        }
-        let scale = light_scale(p)?;
-        if p.has("power") || p.has("illuminance") {
-            self.b.ignore(format!("LightSource \"{kind}\" \"power\"/\"illuminance\" (scale and L/I are used)"));
-        }
-        let point = |v: Option<Vec3>, d: Vec3| to_world.transform_point3(v.unwrap_or(d).as_dvec3()).as_vec3();
-        match kind {
-            "point" => {
-                let i = self.spectrum(p, "I", Vec3::ONE)? * scale;
-                let position = point(p.vec3("from", &["point3", "point"])?, Vec3::ZERO);
-                self.b.scene.punctual_lights.push(PunctualLight::Point { position, intensity: i });
-            }
-            "spot" => {
-                let i = self.spectrum(p, "I", Vec3::ONE)? * scale;
-                let from = point(p.vec3("from", &["point3", "point"])?, Vec3::ZERO);
-                let to = point(p.vec3("to", &["point3", "point"])?, Vec3::Z);
-                let cone = p.float("coneangle", 30.0)?.to_radians();
-                let delta = p.float("conedelta", 5.0)?.to_radians();
-                self.b.scene.punctual_lights.push(PunctualLight::Spot {
-                    position: from,
-                    direction: (to - from).normalize_or(Vec3::NEG_Y),
-                    intensity: i,
-                    inner_cone: (cone - delta).max(0.0),
-                    outer_cone: cone,
-                });
-            }
-            "distant" => {
-                let l = self.spectrum(p, "L", Vec3::ONE)? * scale;
-                let from = p.vec3("from", &["point3", "point"])?.unwrap_or(Vec3::ZERO);
-                let to = p.vec3("to", &["point3", "point"])?.unwrap_or(Vec3::Z);
-                let dir = to_world.transform_vector3((to - from).as_dvec3()).as_vec3();
-                if dir.length_squared() == 0.0 {
-                    return Err(p.error("LightSource \"distant\": \"from\" and \"to\" are the same point"));
-                }
-                self.b
-                    .scene
-                    .punctual_lights
-                    .push(PunctualLight::Directional { direction: dir.normalize(), irradiance: l });
-            }
-            "infinite" => {
-                self.env_lights += 1;
-                if self.env_lights > 1 {
-                    self.b.ignore("a second LightSource \"infinite\" (mislab has one environment)");
-                    for u in p.unused() {
-                        p.has(u.trim_matches('"').split(' ').nth(1).unwrap_or(""));
-                    }
-                    return Ok(());
-                }
-                let light_from_world = Mat3::from_mat4(to_world.as_mat4()).inverse();
-                if let Some(file) = p.string("filename")? {
-                    let path = self.dir.resolve(&file, &p.file, p.line)?;
-                    let by = at(&p.file, p.line);
-                    let (w, h, texels) = load_float_image(&path, &by)?;
-                    if w != h {
-                        self.b.ignore("a non-square infinite light map (read as lat-long)");
-                    }
-                    let layout = if w == h { Layout::EqualArea } else { Layout::Equirect };
-                    let map = env_import::resample(path, &texels, w, h, layout, light_from_world, ENV_HEIGHT);
-                    self.b.scene.environment = Environment::Map { map: Arc::new(map), scale, rotation: 0.0 };
-                    p.has("L");
-                } else {
-                    let l = self.spectrum(p, "L", Vec3::ONE)? * scale;
-                    self.b.scene.environment = Environment::Constant(l);
-                }
-                p.has("portal");
-            }
-            _ => {
-                self.b.ignore_at(format!("LightSource \"{}\"", clip(kind, 40)), at(&p.file, p.line));
-                for u in p.unused() {
-                    p.has(u.trim_matches('"').split(' ').nth(1).unwrap_or(""));
-                }
-                return Ok(());
-            }
-        }
-        if !lights_are_finite(&self.b.scene) {
-            return Err(p.error("the light's intensity, position or direction is out of the range of 32-bit floats"));
-        }
-        self.b.count(&format!("{kind} lights"), 1);
-        Ok(())
-    }
-
-    fn shape(&mut self, s: ShapeCall) -> Result<(), SceneError> {
-        let p = &*s.params;
-        let emission = s.area.as_ref().map_or(Vec3::ZERO, |a| a.radiance);
-        // Cut-outs: a float texture (its image is the mask) or a constant (0 = the shape is invisible).
-        let mut mask = None;
-        match p.type_of("alpha") {
-            Some("texture") => {
-                let name = p.string_of("alpha", &["texture"])?.expect("present");
-                match self.textures.get(&name) {
-                    Some(MatParam::Texture(t)) => {
-                        if t.uv != [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
-                            self.b.ignore("uscale/vscale/udelta/vdelta of alpha textures (the mask uses the mesh uv)");
-                        }
-                        let (file, by) = (t.file.clone(), t.referenced_by.clone());
-                        mask = Some(self.b.alpha_mask(&file, &by)?);
-                    }
-                    Some(_) => self.b.ignore("non-image alpha textures (opaque)"),
-                    None => return Err(p.error(format!("\"texture alpha\" \"{name}\": no such texture"))),
-                }
-            }
-            Some(_) if p.float("alpha", 1.0)? < 0.5 => {
-                self.b.count("shapes cut out by \"float alpha\" 0", 1);
-                return Ok(());
-            }
-            _ => {}
-        }
-        let to_world = (self.mirror * s.ctm).as_mat4();
-        let flip = s.reverse ^ (Mat3::from_mat4(to_world).determinant() < 0.0);
-        let mesh: Option<ObjectMesh> = match s.kind.as_str() {
-            "trianglemesh" => Some(shapes::inline_mesh(p, "trianglemesh", false)?),
-            "bilinearmesh" => Some(shapes::inline_mesh(p, "bilinearmesh", true)?),
-            "plymesh" => {
-                if p.has("displacement") || p.has("edgelength") {
-                    self.b.ignore("plymesh displacement");
-                }
-                Some(shapes::ply_mesh(p, &self.dir)?)
-            }
-            "disk" => {
-                if p.float("innerradius", 0.0)? > 0.0 || p.float("phimax", 360.0)? < 360.0 {
-                    self.b.ignore("partial disks (rendered whole)");
-                }
-                Some(shapes::disk(p, s.reverse)?)
-            }
-            "sphere" => None,
-            other => {
-                self.b.ignore_at(format!("Shape \"{}\"", clip(other, 40)), at(&p.file, p.line));
-                return Ok(());
-            }
-        };
-        let two_sided = s.area.as_ref().is_some_and(|a| a.two_sided);
-        let Some(material) = self.b.material(s.material, emission, two_sided)? else {
-            self.b.invisible_shapes += 1;
-            return Ok(());
-        };
-        let material = match mask {
-            Some(t) if s.kind != "sphere" => self.b.masked_material(material, t),
-            Some(_) => {
-                self.b.ignore("alpha cut-outs on spheres (rendered opaque)");
-                material
-            }
-            None => material,
-        };
-        match mesh {
-            Some(m) => self.b.add_mesh(m, to_world, flip, material).map_err(|e| p.error(e))?,
-            None => {
-                let radius = p.float("radius", 1.0)?;
-                if !(radius > 0.0) {
-                    return Err(p.error(format!("sphere radius {radius} must be > 0")));
-                }
-                if p.has("zmin") || p.has("zmax") || p.has("phimax") {
-                    self.b.ignore("partial spheres (rendered whole)");
-                }
-                if s.reverse && s.area.is_some() {
-                    self.b.ignore("ReverseOrientation on sphere emitters (they emit outwards)");
-                }
-                self.b.add_sphere(to_world, radius, material).map_err(|e| p.error(e))?;
-            }
-        }
-        self.b.count(&format!("{} shapes", s.kind), 1);
-        for u in p.unused() {
-            self.b.ignore(format!("Shape \"{}\" parameter {u}", s.kind));
-        }
-        Ok(())
-    }
-}
-
-/// Whether every punctual light and the constant environment are finite (the importers check each light as
-/// they add it, so a failure is the last one's).
-fn lights_are_finite(scene: &Scene) -> bool {
-    scene.punctual_lights.iter().all(crate::scene::punctual_light_is_finite)
-        && !matches!(scene.environment, Environment::Constant(c) if !c.is_finite())
-}
-
-/// A light's `"float scale"`: finite and ≥ 0 (a negative one would make a light that absorbs).
-fn light_scale(p: &Params) -> Result<f32, SceneError> {
-    let scale = p.float("scale", 1.0)?;
-    if !(scale >= 0.0 && scale.is_finite()) {
-        return Err(p.error(format!("a light's \"scale\" must be a finite number ≥ 0, not {scale}")));
-    }
-    Ok(scale)
 }
 
 /// pbrt's LookAt (camera-from-world): x = up × dir, y = dir × x, z = dir.
@@ -799,22 +615,4 @@ fn look_at(v: &[f64]) -> Option<DMat4> {
     let new_up = dir.cross(right);
     let world_from_camera = DMat4::from_cols(right.extend(0.0), new_up.extend(0.0), dir.extend(0.0), eye.extend(1.0));
     Some(world_from_camera.inverse())
-}
-
-/// A float RGB image for an environment: PFM (ours) or EXR (the image crate), top row first.
-fn load_float_image(path: &Path, by: &str) -> Result<(u32, u32, Vec<[f32; 3]>), SceneError> {
-    let bytes = read_bytes(path, by)?;
-    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
-    let bad = |m: String| SceneError::new(path, format!("{m} (referenced by {by})"));
-    let format = match ext.as_str() {
-        "pfm" => return crate::scene::pfm::decode(&bytes).map(|p| (p.width, p.height, p.texels)).map_err(bad),
-        "exr" => image::ImageFormat::OpenExr,
-        "hdr" => image::ImageFormat::Hdr,
-        _ => {
-            let ext = clip(&ext, 20);
-            return Err(bad(format!("unsupported environment map format '.{ext}' (expected .pfm, .exr or .hdr)")));
-        }
-    };
-    let img = crate::scene::import_texture::decode_limited(&bytes, format).map_err(bad)?.to_rgb32f();
-    Ok((img.width(), img.height(), img.pixels().map(|p| p.0).collect()))
 }
