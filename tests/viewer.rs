@@ -474,7 +474,10 @@ fn a_sky_lit_room_learns_its_guide_and_renders_on() {
     let mut a = args();
     a.scene.scene = path.display().to_string();
     let (mut h, _one) = harness(a);
-    step_until(&mut h, "three samples per pixel", |s| s.stats[0].spp >= 3);
+    // The image statistics follow the samples at the engine's cadence (STATS_INTERVAL), so wait for both.
+    step_until(&mut h, "three samples per pixel and their image statistics", |s| {
+        s.stats[0].spp >= 3 && s.stats[0].image.mean_rel_se.is_some()
+    });
     {
         let s = h.state().engine().shared();
         assert_eq!(s.stats[0].settings.env_sampling, EnvSampling::Auto, "auto is the default");

@@ -92,9 +92,11 @@ impl Engine {
         for (i, d) in &dispatches {
             if matches!(d, Dispatch::Preview) {
                 self.image_stats[*i] = ImageStats::default();
+                // The panel shows no statistics until the next one; compute them in the first band frame.
+                self.stats_pending = true;
             }
         }
-        let stats = !preview_frame && (full || self.last_stats.elapsed() >= STATS_INTERVAL);
+        let stats = !preview_frame && (full || self.stats_pending || self.last_stats.elapsed() >= STATS_INTERVAL);
         if stats {
             self.last_stats = Instant::now();
         }
@@ -173,6 +175,7 @@ impl Engine {
         self.last_options = Some((self.options, self.reference.is_some(), self.compare));
         if let Some(s) = out.stats {
             self.image_stats = s;
+            self.stats_pending = false;
         }
         self.publish_stats();
         Ok(true)

@@ -93,6 +93,8 @@ struct Engine {
     last_options: Option<(DisplayOptions, bool, bool)>,
     /// When the statistics were last summed, and their values.
     last_stats: Instant,
+    /// A restart cleared the image statistics; the next frame that renders samples computes them.
+    stats_pending: bool,
     image_stats: [ImageStats; 2],
 }
 
@@ -191,6 +193,7 @@ impl Engine {
             recoveries: 0,
             last_options: None,
             last_stats: Instant::now(),
+            stats_pending: false,
             image_stats: Default::default(),
         };
         e.request_pipelines();
