@@ -518,22 +518,42 @@ fn a_signal_during_start_up_writes_nothing_and_says_so() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("x.png");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_mislab"));
-    // Path tracing of the Cornell box: its start-up (device, BVH, shader compilation) takes seconds on lavapipe.
+    // Path tracing of the Cornell box, with empty caches (its own XDG_CACHE_HOME: no stored pipeline, no Mesa
+    // shader cache), so that the shader compilation after the "adapter:" line takes most of a second or more.
     cmd.args(["render", "cornell-box", "--mode", "path", "--spp", "100000", "--width", "64", "--height", "64", "-o"])
         .arg(&out)
+        .env("XDG_CACHE_HOME", dir.join("cache"))
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
-    let child = cmd.spawn().unwrap();
-    // After the handler is installed (right after the flags are parsed), before the first sample.
-    std::thread::sleep(Duration::from_millis(300));
+    let mut child = cmd.spawn().unwrap();
+    // The signal goes once the process says which adapter it opened: its handler is installed (right after the
+    // flags are parsed) and its pipeline not yet compiled, whatever this machine's speed.
+    let (tx, rx) = std::sync::mpsc::channel();
+    let mut pipe = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let (mut all, mut buf, mut told) = (Vec::new(), [0u8; 256], false);
+        while let Ok(n) = pipe.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            all.extend_from_slice(&buf[..n]);
+            if !told && String::from_utf8_lossy(&all).contains("adapter:") {
+                let _ = tx.send(());
+                told = true;
+            }
+        }
+        String::from_utf8_lossy(&all).into_owned()
+    });
+    let opened = rx.recv_timeout(TIMEOUT);
     // SAFETY: kill(2) on our own child's pid.
     assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
     let start = Instant::now();
-    let o = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    println!("exit {:?} {:.1} s after SIGTERM:\n{err}", o.status.code(), start.elapsed().as_secs_f64());
-    assert_eq!(o.status.code(), Some(130), "{err}");
+    let o = child.wait().unwrap();
+    let err = reader.join().unwrap();
+    opened.unwrap_or_else(|_| panic!("no adapter line within {TIMEOUT:?}:\n{err}"));
+    println!("exit {:?} {:.1} s after SIGTERM:\n{err}", o.code(), start.elapsed().as_secs_f64());
+    assert_eq!(o.code(), Some(130), "{err}");
     assert!(err.contains("interrupted during start-up") && err.contains("no image was written"), "{err}");
     assert!(!out.exists(), "a signal before any sample must not leave an (empty) image");
     let _ = std::fs::remove_dir_all(&dir);
