@@ -10,6 +10,8 @@
 //! Also: a scene larger than the device's storage-buffer binding limit is refused with an error naming the
 //! limit, end to end with a generated texture, and at the unit level with a synthetic `SceneData`.
 
+mod common;
+
 use mislab::render::{gpu_scene::check_binding_sizes, scene_data::SceneData};
 use std::collections::BTreeMap;
 use std::io::Read;
@@ -529,22 +531,7 @@ fn a_signal_during_start_up_writes_nothing_and_says_so() {
     let mut child = cmd.spawn().unwrap();
     // The signal goes once the process says which adapter it opened: its handler is installed (right after the
     // flags are parsed) and its pipeline not yet compiled, whatever this machine's speed.
-    let (tx, rx) = std::sync::mpsc::channel();
-    let mut pipe = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let (mut all, mut buf, mut told) = (Vec::new(), [0u8; 256], false);
-        while let Ok(n) = pipe.read(&mut buf) {
-            if n == 0 {
-                break;
-            }
-            all.extend_from_slice(&buf[..n]);
-            if !told && String::from_utf8_lossy(&all).contains("adapter:") {
-                let _ = tx.send(());
-                told = true;
-            }
-        }
-        String::from_utf8_lossy(&all).into_owned()
-    });
+    let (rx, reader) = common::watch_stderr(&mut child, "adapter:");
     let opened = rx.recv_timeout(TIMEOUT);
     // SAFETY: kill(2) on our own child's pid.
     assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);

@@ -2,6 +2,8 @@
 //! clear error naming the file with exit code 2 (never a panic or a hang, never a half-written image),
 //! a missing adapter is exit code 2 with instructions, and Ctrl-C still writes the image.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -173,25 +175,7 @@ fn interrupt_writes_what_has_accumulated() {
     let mut child = c.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
     let pid = child.id();
     // Wait until rendering has started (start-up compiles the pipeline), then interrupt.
-    let (tx, rx) = std::sync::mpsc::channel();
-    let mut pipe = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        use std::io::Read;
-        let mut all = Vec::new();
-        let mut buf = [0u8; 256];
-        let mut told = false;
-        while let Ok(n) = pipe.read(&mut buf) {
-            if n == 0 {
-                break;
-            }
-            all.extend_from_slice(&buf[..n]);
-            if !told && String::from_utf8_lossy(&all).contains("start-up:") {
-                let _ = tx.send(());
-                told = true;
-            }
-        }
-        String::from_utf8_lossy(&all).into_owned()
-    });
+    let (rx, reader) = common::watch_stderr(&mut child, "start-up:");
     rx.recv_timeout(Duration::from_secs(120)).expect("rendering never started");
     std::thread::sleep(Duration::from_secs(2));
     let status = Command::new("kill").args(["-INT", &pid.to_string()]).status().unwrap();

@@ -141,3 +141,30 @@ pub fn mesh_of(name: &str, tris: &[[Vec3; 3]], material: u32) -> mislab::scene::
 pub fn rect(c: Vec3, u: Vec3, v: Vec3) -> [[Vec3; 3]; 2] {
     [[c, c + u, c + u + v], [c, c + u + v, c + v]]
 }
+
+/// Reads a child process's piped stderr on a thread, so that it never blocks on a full pipe: the receiver gets a
+/// message once the text so far contains `needle` (a line that marks a moment of its run), and the thread returns
+/// the whole text when the child closes the pipe.
+pub fn watch_stderr(
+    child: &mut std::process::Child,
+    needle: &'static str,
+) -> (std::sync::mpsc::Receiver<()>, std::thread::JoinHandle<String>) {
+    use std::io::Read;
+    let (tx, rx) = std::sync::mpsc::channel();
+    let mut pipe = child.stderr.take().expect("the child's stderr is piped");
+    let reader = std::thread::spawn(move || {
+        let (mut all, mut buf, mut told) = (Vec::new(), [0u8; 256], false);
+        while let Ok(n) = pipe.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            all.extend_from_slice(&buf[..n]);
+            if !told && String::from_utf8_lossy(&all).contains(needle) {
+                let _ = tx.send(());
+                told = true;
+            }
+        }
+        String::from_utf8_lossy(&all).into_owned()
+    });
+    (rx, reader)
+}
