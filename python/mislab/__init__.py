@@ -34,6 +34,7 @@ __all__ = [
     "compare",
     "load",
     "merge",
+    "pipelines_compiled",
     "reference",
     "render",
     "render_progressive",
@@ -303,6 +304,12 @@ def settings() -> Dict[str, Dict[str, Any]]:
 def adapter() -> str:
     """The device renders run on (opens it if no render has yet)."""
     return _native.adapter()
+
+
+def pipelines_compiled() -> int:
+    """Render pipelines this process has compiled so far. Every render reuses them: a render with the scene
+    features and settings of an earlier one compiles nothing and starts at once."""
+    return _native.pipelines_compiled()
 
 
 def _settings_doc() -> str:

@@ -384,6 +384,13 @@ fn adapter() -> PyResult<String> {
     Ok(lab()?.adapter())
 }
 
+/// Render pipelines this process has compiled so far (every render reuses them: one with the same scene features
+/// and settings compiles nothing).
+#[pyfunction]
+fn pipelines_compiled() -> PyResult<usize> {
+    Ok(lab()?.pipelines_compiled())
+}
+
 /// The module: the functions above, the scene and image classes, `SceneError`, and `REFERENCE_SEED` (the seed
 /// of references, distinct from the seeds 0, 1, … that benchmarks measure).
 #[pymodule]
@@ -403,5 +410,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(merge, m)?)?;
     m.add_function(wrap_pyfunction!(settings, m)?)?;
     m.add_function(wrap_pyfunction!(adapter, m)?)?;
+    m.add_function(wrap_pyfunction!(pipelines_compiled, m)?)?;
     Ok(())
 }
