@@ -1,7 +1,8 @@
 //! Time to an image, end to end: whole `mislab render` processes (process start → image written), each scene rendered
 //! twice — first with empty caches (a fresh cache directory: Mesa's shader cache and mislab's pipeline store both
 //! live under `XDG_CACHE_HOME`), then again with what the first run left there. The start-up line each run prints
-//! splits its start-up into scene load and BVH, device, and upload + shader compilation.
+//! splits its start-up into scene load, BVH (built or read from the store), device, upload, pipeline (naga, the
+//! pruner, creation) and the first dispatch (where lavapipe compiles the kernel).
 //! `cargo bench --bench startup` (MISLAB_BENCH_SIZE, default 512; MISLAB_BENCH_SPP, default 16; MISLAB_BENCH_ROUNDS,
 //! default 2, interleaving the scenes so machine load hits all alike).
 
@@ -13,10 +14,15 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::time::Instant;
 
+/// The start-up line's total and parts, by the words before each number.
+const STARTUP_PARTS: [&str; 7] =
+    ["start-up: ", "scene load ", "BVH ", "device ", "upload ", "pipeline ", "first dispatch "];
+
 /// The measurements of one process.
 struct Run {
     wall: f64,
-    startup: [f64; 4],
+    /// Start-up, then its parts as the start-up line names them (`STARTUP_PARTS`).
+    startup: [f64; 7],
     render: f64,
 }
 
@@ -39,12 +45,10 @@ fn run(scene: &str, size: u32, spp: u32, cache: &PathBuf, out: &PathBuf) -> Run 
     let wall = t.elapsed().as_secs_f64();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "mislab render {scene} failed:\n{err}");
-    let get = |k: &str| seconds_after(&err, k).unwrap_or_else(|| panic!("no '{k}' in the output:\n{err}"));
-    Run {
-        wall,
-        startup: [get("start-up: "), get("scene load and BVH "), get("device "), get("upload + shader compilation ")],
-        render: get(&format!("{spp} spp in ")),
-    }
+    let get = |text: &str, k: &str| seconds_after(text, k).unwrap_or_else(|| panic!("no '{k}' in:\n{err}"));
+    // The parts from the start-up line alone: the scene line also says "BVH".
+    let line = err.lines().find(|l| l.starts_with("start-up: ")).unwrap_or_else(|| panic!("no start-up line:\n{err}"));
+    Run { wall, startup: STARTUP_PARTS.map(|k| get(line, k)), render: get(&err, &format!("{spp} spp in ")) }
 }
 
 fn main() {
@@ -63,8 +67,8 @@ fn main() {
         "whole `mislab render` processes, {size}x{size}, {spp} spp, path depth 8, MIS power, Sobol; {rounds} rounds"
     );
     println!(
-        "{:<22} {:>9} {:>9} {:>9} {:>7} {:>7} {:>9} {:>8}",
-        "scene", "run", "process s", "start-up", "load", "device", "compile", "render"
+        "{:<22} {:>9} {:>9} {:>9} {:>6} {:>6} {:>6} {:>6} {:>8} {:>8} {:>8}",
+        "scene", "run", "process s", "start-up", "load", "BVH", "device", "upload", "pipeline", "dispatch", "render"
     );
     for round in 0..rounds {
         for scene in &scenes {
@@ -73,9 +77,10 @@ fn main() {
             let name = std::path::Path::new(scene).file_stem().and_then(|s| s.to_str()).unwrap_or(scene);
             for which in ["first", "repeated"] {
                 let r = run(scene, size, spp, &cache, &out);
+                let [start, load, bvh, device, upload, pipeline, dispatch] = r.startup;
                 println!(
-                    "{:<22} {:>9} {:>9.2} {:>9.2} {:>7.2} {:>7.2} {:>9.2} {:>8.2}",
-                    name, which, r.wall, r.startup[0], r.startup[1], r.startup[2], r.startup[3], r.render
+                    "{:<22} {:>9} {:>9.2} {:>9.2} {:>6.2} {:>6.2} {:>6.2} {:>6.2} {:>8.2} {:>8.2} {:>8.2}",
+                    name, which, r.wall, start, load, bvh, device, upload, pipeline, dispatch, r.render
                 );
             }
         }

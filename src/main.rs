@@ -235,13 +235,18 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
         state: job.state_path().is_some(),
         pixels,
         interrupt: &interrupt,
-        started: |seconds: f64| {
+        started: |s: &api::Startup| {
+            let bvh = scene.data().bvh_seconds;
+            let load = (t_loaded - t_start).as_secs_f64();
             eprintln!(
-                "start-up: {:.2} s (scene load and BVH {:.2} s, device {:.2} s, upload + shader compilation {:.2} s) — not counted in the render time",
-                (t_device - t_start).as_secs_f64() + seconds,
-                (t_loaded - t_start).as_secs_f64(),
+                "start-up: {:.2} s (scene load {:.2} s, BVH {:.2} s, device {:.2} s, upload {:.2} s, pipeline {:.2} s, first dispatch {:.2} s) — not counted in the render time",
+                (t_device - t_start).as_secs_f64() + s.seconds,
+                (load - bvh).max(0.0),
+                bvh,
                 (t_device - t_loaded).as_secs_f64(),
-                seconds
+                s.upload,
+                s.pipeline,
+                s.first_dispatch
             );
         },
     };
@@ -296,7 +301,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
 }
 
 /// The render command's observer: a progress bar (shown once sampling starts), the start-up line, and Ctrl-C.
-struct CliObserver<'a, S: FnMut(f64)> {
+struct CliObserver<'a, S: FnMut(&api::Startup)> {
     bar: indicatif::ProgressBar,
     budget: api::Budget,
     /// A state render counts its bar in sample indices (a resumed render starts where it stopped).
@@ -306,9 +311,9 @@ struct CliObserver<'a, S: FnMut(f64)> {
     started: S,
 }
 
-impl<S: FnMut(f64)> api::Observer for CliObserver<'_, S> {
-    fn started(&mut self, seconds: f64) {
-        (self.started)(seconds);
+impl<S: FnMut(&api::Startup)> api::Observer for CliObserver<'_, S> {
+    fn started(&mut self, startup: &api::Startup) {
+        (self.started)(startup);
         self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         self.bar.set_style(
             indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")

@@ -34,7 +34,7 @@ pub use image::{header_attributes, Image};
 pub use job::{take_file_settings, Job};
 pub use lab::Lab;
 pub use merge::merge;
-pub use observer::{Callbacks, Observer, Progress, Unobserved};
+pub use observer::{Callbacks, Observer, Progress, Startup, Unobserved};
 pub use render::{render, Render};
 pub use report::adapters;
 pub use scene::SceneHandle;

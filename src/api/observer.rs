@@ -16,14 +16,30 @@ pub struct Progress {
     pub nonfinite: u64,
 }
 
+/// Where a render's start-up went (`Observer::started`), in seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Startup {
+    /// From the render being asked for to its first sample: the parts below and the small steps between them.
+    pub seconds: f64,
+    /// The scene's buffers on the device (the first render of a scene on a lab), the render's own buffers, and
+    /// the sky probe of `--env-sampling auto`.
+    pub upload: f64,
+    /// The pipeline: its WGSL specialised and pruned, translated by naga and created — or found in the lab or in
+    /// the pipeline store.
+    pub pipeline: f64,
+    /// The first dispatch, which does no sampling: a driver that compiles at first use (lavapipe) compiles the
+    /// kernel here; elsewhere it is a few milliseconds.
+    pub first_dispatch: f64,
+}
+
 /// Watches a render; may stop it. Every method is called on the thread that renders.
 pub trait Observer {
     /// A line for the user (`note: …` or `warning: …`): by default written to stderr.
     fn note(&mut self, line: &str) {
         eprintln!("{line}");
     }
-    /// Start-up is over (scene uploaded, pipeline compiled): `seconds` since the render was asked for.
-    fn started(&mut self, _seconds: f64) {}
+    /// Start-up is over (scene uploaded, pipeline compiled), and where its time went.
+    fn started(&mut self, _startup: &Startup) {}
     /// After every submission.
     fn progress(&mut self, _progress: &Progress) {}
     /// Before every submission: true stops the render, which returns what it has (`interrupted`).

@@ -7,7 +7,7 @@ use super::error::ApiError;
 use super::image::Image;
 use super::job::Job;
 use super::lab::Lab;
-use super::observer::Observer;
+use super::observer::{Observer, Startup};
 use super::scene::SceneHandle;
 use crate::render::settings::Settings;
 use crate::render::{reachability, Renderer};
@@ -84,9 +84,21 @@ impl Render {
         if let Some(w) = reachability::unreachable_light_warning(scene.data(), &settings) {
             observer.note(&format!("warning: {w}"));
         }
-        let gpu_scene = scene.upload(lab)?;
         let ctx = lab.gpu();
-        let mut renderer = Renderer::new(ctx, &gpu_scene, scene.camera().clone(), settings.clone())?;
+        // Renderer::new's three steps, timed one by one for the start-up report.
+        let t_upload = Instant::now();
+        let gpu_scene = scene.upload(lab)?;
+        let mut renderer = Renderer::new_unprepared(ctx, &gpu_scene, scene.camera().clone(), settings.clone())?;
+        let t_pipeline = Instant::now();
+        renderer.prepare()?;
+        let t_first_dispatch = Instant::now();
+        renderer.warm_up(ctx)?;
+        let mut startup = Startup {
+            upload: (t_pipeline - t_upload).as_secs_f64(),
+            pipeline: (t_first_dispatch - t_pipeline).as_secs_f64(),
+            first_dispatch: t_first_dispatch.elapsed().as_secs_f64(),
+            ..Startup::default()
+        };
         if let Budget::Samples(n) = job.budget {
             renderer.set_sampler_spp(n);
         }
@@ -96,7 +108,8 @@ impl Render {
                 .map_err(ApiError::from)?;
         }
         ctx.wait()?;
-        observer.started(t0.elapsed().as_secs_f64());
+        startup.seconds = t0.elapsed().as_secs_f64();
+        observer.started(&startup);
         let first_sample = renderer.samples();
         Ok(Render { renderer, scene: scene.spec().clone(), settings, first_sample, stats: RenderStats::default() })
     }
