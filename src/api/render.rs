@@ -85,20 +85,12 @@ impl Render {
             observer.note(&format!("warning: {w}"));
         }
         let ctx = lab.gpu();
-        // Renderer::new's three steps, timed one by one for the start-up report.
         let t_upload = Instant::now();
         let gpu_scene = scene.upload(lab)?;
-        let mut renderer = Renderer::new_unprepared(ctx, &gpu_scene, scene.camera().clone(), settings.clone())?;
-        let t_pipeline = Instant::now();
-        renderer.prepare()?;
-        let t_first_dispatch = Instant::now();
-        renderer.warm_up(ctx)?;
-        let mut startup = Startup {
-            upload: (t_pipeline - t_upload).as_secs_f64(),
-            pipeline: (t_first_dispatch - t_pipeline).as_secs_f64(),
-            first_dispatch: t_first_dispatch.elapsed().as_secs_f64(),
-            ..Startup::default()
-        };
+        let scene_upload = t_upload.elapsed().as_secs_f64();
+        let (mut renderer, [buffers, pipeline, first_dispatch]) =
+            Renderer::new_timed(ctx, &gpu_scene, scene.camera().clone(), settings.clone())?;
+        let mut startup = Startup { upload: scene_upload + buffers, pipeline, first_dispatch, ..Startup::default() };
         if let Budget::Samples(n) = job.budget {
             renderer.set_sampler_spp(n);
         }

@@ -119,10 +119,25 @@ impl Renderer {
         camera: Camera,
         settings: Settings,
     ) -> Result<Renderer, RenderError> {
+        Ok(Renderer::new_timed(ctx, scene, camera, settings)?.0)
+    }
+
+    /// As `new`, with the seconds of its three steps for a start-up report: the per-render buffers (and the sky
+    /// probe), the pipeline (built, or found in a cache), and the first dispatch (where a driver that compiles at
+    /// first use, like lavapipe, compiles the kernel).
+    pub fn new_timed(
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        camera: Camera,
+        settings: Settings,
+    ) -> Result<(Renderer, [f64; 3]), RenderError> {
+        let t0 = web_time::Instant::now();
         let mut r = Renderer::new_unprepared(ctx, scene, camera, settings)?;
+        let t1 = web_time::Instant::now();
         r.prepare()?;
+        let t2 = web_time::Instant::now();
         r.warm_up(ctx)?;
-        Ok(r)
+        Ok((r, [(t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64(), t2.elapsed().as_secs_f64()]))
     }
 
     /// The per-render buffers only, with no pipeline yet: the viewer compiles pipelines on another
