@@ -369,10 +369,10 @@ impl GpuContext {
         extra: wgpu::BufferUsages,
     ) -> wgpu::Buffer {
         use wgpu::util::DeviceExt;
-        let mut bytes = bytes.to_vec();
         let min = 16.max(element_size);
+        let mut bytes = std::borrow::Cow::Borrowed(bytes);
         if bytes.len() < min {
-            bytes.resize(min, 0);
+            bytes.to_mut().resize(min, 0);
         }
         self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),

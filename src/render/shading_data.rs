@@ -20,6 +20,7 @@ use glam::{Vec2, Vec3};
 
 pub use crate::gpu::octahedral::{oct_decode, oct_encode, NO_NORMAL};
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// The material word of a shading vertex: the material index in the low 16 bits, the cut-out mask (0 none, k + 1
 /// texture k's alpha channel, shaders/alpha.wgsl) in the high 16. Scenes beyond these are refused at load
@@ -74,7 +75,35 @@ pub struct ShadingTable {
     pub tris: Vec<GpuTriShading>,
     /// Distinct shading vertices.
     pub verts: Vec<GpuShadingVertex>,
-    index: HashMap<[u32; 4], u32>,
+    index: HashMap<[u32; 4], u32, BuildHasherDefault<WordHasher>>,
+}
+
+/// A multiply-rotate hash of machine words (the Fx hash's step: rotate, xor the word in, multiply by an odd
+/// constant) for the table's keys of four words, which no one chooses adversarially: std's SipHash made the table
+/// a third of a 270k-triangle scene's flattening.
+#[derive(Default)]
+pub struct WordHasher(u64);
+
+impl Hasher for WordHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u64(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn write_usize(&mut self, word: usize) {
+        self.write_u64(word as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
 }
 
 impl ShadingTable {

@@ -237,7 +237,11 @@ impl SceneData {
             Some(occluders) => (0..tris.len()).filter(|i| !occluders.contains(i)).collect(),
             None => (0..tris.len()).collect(),
         };
-        let bvh_tris: Vec<[Vec3; 3]> = in_bvh.iter().map(|&i| tris[i]).collect();
+        // The BVH's triangles: all of them unless some are baked occluders.
+        let bvh_tris: std::borrow::Cow<[[Vec3; 3]]> = match &split {
+            Some(_) => in_bvh.iter().map(|&i| tris[i]).collect::<Vec<_>>().into(),
+            None => tris.as_slice().into(),
+        };
         let presplit = if split.is_some() { bvh::Presplit::Off } else { presplit };
         // Built, or read back from an earlier run's build of the same input (`bvh_store`).
         let mut bvh = crate::render::bvh_store::build(&bvh_tris, &d.spheres, &d.quads, presplit);
@@ -246,12 +250,17 @@ impl SceneData {
         d.triangles = tris.len();
         let mut order: Vec<u32> =
             bvh::into_leaf_order(&mut bvh, bvh_tris.len()).into_iter().map(|j| in_bvh[j as usize] as u32).collect();
+        drop(bvh_tris);
         if let Some(occluders) = &split {
             d.occluders = (order.len() as u32, occluders.len() as u32);
             order.extend(occluders.iter().map(|&i| i as u32));
         }
         tris = order.iter().map(|&i| tris[i as usize]).collect();
-        d.tri_verts = order.iter().flat_map(|&i| d.tri_verts[3 * i as usize..3 * i as usize + 3].to_vec()).collect();
+        let mut verts = Vec::with_capacity(3 * order.len());
+        for &i in &order {
+            verts.extend_from_slice(&d.tri_verts[3 * i as usize..3 * i as usize + 3]);
+        }
+        d.tri_verts = verts;
         d.tri_shading = order.iter().map(|&i| d.tri_shading[i as usize]).collect();
         d.bvh_seconds = bvh.build_seconds;
         d.bvh_sah = bvh.sah_cost;
