@@ -205,13 +205,17 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
             EXIT_INTERRUPTED
         })
     };
-    // The scene first: a bad file is reported without waiting for (or needing) a device.
+    // The device opens on a second thread while the scene loads, and there builds the render pipeline the last
+    // run of this command used (`Lab::build_forecast`): a repeated render then finds it ready.
+    let command = forecast_command(&args.scene, &job.settings);
+    let opening = Opening::start(command.clone());
+    // A bad scene is reported without waiting for (or needing) a device.
     let scene = api::SceneHandle::load(&args.scene).map_err(bad)?;
     if let Some(code) = startup_interrupted() {
         return Ok(code);
     }
     let t_loaded = Instant::now();
-    let lab = api::Lab::open().map_err(bad)?;
+    let lab = opening.lab().map_err(bad)?;
     if let Some(code) = startup_interrupted() {
         return Ok(code);
     }
@@ -248,9 +252,15 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
                 s.pipeline,
                 s.first_dispatch
             );
+            if lab.forecasts_taken() > 0 {
+                eprintln!(
+                    "note: the render pipeline was built while the scene loaded (the last run of this command's)"
+                );
+            }
         },
     };
     let image = api::render(&lab, &scene, &mut job, &mut observer).map_err(bad)?;
+    lab.save_forecast(&command);
     observer.bar.finish_and_clear();
     let stats = &image.stats;
     if stats.interrupted && stats.spp == 0 {
@@ -347,4 +357,51 @@ fn info(scene_name: Option<String>) -> Result<u8, Failure> {
         }
     }
     Ok(0)
+}
+
+/// What tells one `mislab render`'s render pipeline from another's before its scene is loaded: the working
+/// directory, the scene as named and the settings as given (`Lab::build_forecast`; the pipeline is only a
+/// forecast, taken where the renderer's own request turns out equal).
+fn forecast_command(scene: &mislab::scene::SceneSpec, settings: &mislab::render::settings::Settings) -> String {
+    let cwd = std::env::current_dir().unwrap_or_default();
+    format!("render\n{cwd:?}\n{scene:?}\n{settings:?}")
+}
+
+/// The device opening on a second thread, then building the forecast pipeline (`Lab::build_forecast`), while the
+/// scene loads. However `render` ends, the thread is joined first (told to skip the forecast where the lab is not
+/// taken): a process that exits while another thread is still loading the driver can abort in the driver's
+/// static constructors (LLVM's "registered more than once"), and a bad scene must still end with exit code 2.
+struct Opening {
+    thread: Option<std::thread::JoinHandle<Result<api::Lab, api::ApiError>>>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl Opening {
+    fn start(command: String) -> Opening {
+        let cancel = Arc::new(AtomicBool::new(false));
+        let skip = cancel.clone();
+        let thread = std::thread::spawn(move || {
+            let lab = api::Lab::open()?;
+            if !skip.load(Ordering::SeqCst) {
+                lab.build_forecast(&command);
+            }
+            Ok(lab)
+        });
+        Opening { thread: Some(thread), cancel }
+    }
+
+    /// The opened lab (waiting for the thread).
+    fn lab(mut self) -> Result<api::Lab, api::ApiError> {
+        let thread = self.thread.take().expect("joined once");
+        thread.join().unwrap_or_else(|_| Err(api::ApiError::Device("the device thread panicked".into())))
+    }
+}
+
+impl Drop for Opening {
+    fn drop(&mut self) {
+        self.cancel.store(true, Ordering::SeqCst);
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
 }

@@ -107,7 +107,7 @@ fn the_folder_stays_bounded_oldest_first() {
     }
     std::fs::write(dir.join("other.txt"), vec![0u8; 5000]).unwrap();
     // The newest is "c"; "a" is the one just written (kept whatever its time).
-    bvh_store::evict(&dir, 2000, &dir.join("a.bvh"));
+    mislab::io::cache_file::evict(&dir, "bvh", 2000, &dir.join("a.bvh"));
     let left: Vec<bool> = names.iter().map(|n| dir.join(n).exists()).collect();
     assert_eq!(left, [true, false, true], "the oldest file other than the one just written goes first");
     assert!(dir.join("other.txt").exists(), "only .bvh files are the store's");

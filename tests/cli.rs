@@ -189,3 +189,59 @@ fn interrupt_writes_what_has_accumulated() {
     assert!(err.contains("interrupted"), "{err}");
     assert!(out.exists(), "the partial image must be written");
 }
+
+/// The forecast files in a cache directory (`render::pipeline_forecast`), oldest first.
+fn forecasts(cache: &Path) -> Vec<PathBuf> {
+    let Ok(dir) = std::fs::read_dir(cache.join("mislab/forecast")) else { return Vec::new() };
+    let mut files: Vec<_> = dir
+        .filter_map(Result::ok)
+        .filter(|e| e.path().extension().is_some_and(|x| x == "forecast"))
+        .map(|e| (e.metadata().unwrap().modified().unwrap(), e.path()))
+        .collect();
+    files.sort();
+    files.into_iter().map(|(_, p)| p).collect()
+}
+
+#[test]
+fn a_repeated_render_takes_its_forecast_pipeline_and_no_other() {
+    const TAKEN: &str = "note: the render pipeline was built while the scene loaded";
+    let cache = tmp("forecast-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let render = |scene: &str, out: &str| {
+        let out = tmp(out);
+        let mut c = mislab();
+        c.env("XDG_CACHE_HOME", &cache);
+        c.args(["render", scene, "--spp", "2", "--width", "16", "--height", "16", "-o"]).arg(&out);
+        let o = run(c, Duration::from_secs(300));
+        let err = stderr(&o);
+        assert!(o.status.success(), "{scene}: {err}");
+        (err, image::open(&out).expect("the EXR reads back").into_rgb32f().into_raw())
+    };
+    // A first run records its pipeline; the same command again builds it while the scene loads and takes it.
+    let (err, furnace) = render("furnace", "fc-a1.exr");
+    assert!(!err.contains(TAKEN), "nothing to take on a first run:\n{err}");
+    let a = forecasts(&cache);
+    assert_eq!(a.len(), 1, "one forecast per command");
+    let (err, again) = render("furnace", "fc-a2.exr");
+    assert!(err.contains(TAKEN), "a repeated render takes the forecast pipeline:\n{err}");
+    assert_eq!(again, furnace, "the forecast pipeline is the pipeline: the same pixels");
+    // Another command gets a file of its own; given the first command's forecast, it builds its own pipeline.
+    let (err, cornell) = render("cornell-box", "fc-b1.exr");
+    assert!(!err.contains(TAKEN), "{err}");
+    let files = forecasts(&cache);
+    assert_eq!(files.len(), 2);
+    let b = files.into_iter().find(|f| *f != a[0]).expect("the second command's forecast");
+    std::fs::copy(&a[0], &b).unwrap();
+    let (err, cornell_again) = render("cornell-box", "fc-b2.exr");
+    assert!(!err.contains(TAKEN), "another command's pipeline is never taken:\n{err}");
+    assert_eq!(cornell_again, cornell);
+    // A damaged forecast is reported and ignored, and rewritten by the run.
+    std::fs::write(&a[0], b"MISLPF01 not a forecast").unwrap();
+    let (err, damaged) = render("furnace", "fc-a3.exr");
+    assert!(err.contains("warning: pipeline forecast") && err.contains("ignored"), "{err}");
+    assert!(!err.contains(TAKEN), "{err}");
+    assert_eq!(damaged, furnace);
+    let (err, _) = render("furnace", "fc-a4.exr");
+    assert!(err.contains(TAKEN), "the damaged forecast was rewritten:\n{err}");
+    let _ = std::fs::remove_dir_all(&cache);
+}

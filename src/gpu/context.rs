@@ -1,6 +1,7 @@
 //! The GPU context: one Vulkan adapter + device, chosen by `WGPU_ADAPTER_NAME` or by preference,
 //! with the limits the renderer needs and helpers that never wait on the device without a timeout.
 
+use super::pipeline_request::PipelineRequest;
 use super::pipeline_store::{self, PipelineStore};
 use std::time::Duration;
 
@@ -100,6 +101,13 @@ pub struct GpuContext {
 pub struct PipelineMemo {
     built: std::sync::Arc<std::sync::Mutex<std::collections::HashMap<u64, wgpu::ComputePipeline>>>,
     store: Option<std::sync::Arc<PipelineStore>>,
+    /// Pipelines built ahead of their builder from a forecast (`render::pipeline_forecast`), each with the request
+    /// it was built from: taken only for an equal request (`take_offer`).
+    offered: std::sync::Arc<std::sync::Mutex<Vec<(PipelineRequest, wgpu::ComputePipeline)>>>,
+    /// The request of the last pipeline a builder asked for (`note_request`), for the next run's forecast.
+    last: std::sync::Arc<std::sync::Mutex<Option<PipelineRequest>>>,
+    /// How many offered pipelines were taken.
+    taken: std::sync::Arc<std::sync::atomic::AtomicUsize>,
 }
 
 impl PipelineMemo {
@@ -126,6 +134,34 @@ impl PipelineMemo {
     /// The driver's pipeline cache kept on disk, where the device has one: every pipeline is built through it.
     pub fn store(&self) -> Option<&PipelineStore> {
         self.store.as_deref()
+    }
+
+    /// Holds `pipeline`, built from `request` ahead of any builder asking for it.
+    pub fn offer(&self, request: PipelineRequest, pipeline: wgpu::ComputePipeline) {
+        self.offered.lock().unwrap_or_else(|e| e.into_inner()).push((request, pipeline));
+    }
+
+    /// The pipeline offered for a request equal to `request` in every field, if any (it is handed out once).
+    pub fn take_offer(&self, request: &PipelineRequest) -> Option<wgpu::ComputePipeline> {
+        let mut offered = self.offered.lock().unwrap_or_else(|e| e.into_inner());
+        let i = offered.iter().position(|(r, _)| r == request)?;
+        self.taken.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Some(offered.swap_remove(i).1)
+    }
+
+    /// How many offered pipelines builders have taken (`take_offer`).
+    pub fn offers_taken(&self) -> usize {
+        self.taken.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Records the request of the pipeline a builder is using now.
+    pub fn note_request(&self, request: PipelineRequest) {
+        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some(request);
+    }
+
+    /// The request `note_request` saw last.
+    pub fn last_request(&self) -> Option<PipelineRequest> {
+        self.last.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 }
 

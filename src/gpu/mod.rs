@@ -3,9 +3,11 @@
 
 pub mod context;
 pub mod octahedral;
+pub mod pipeline_request;
 pub mod pipeline_store;
 pub mod timer;
 pub mod types;
 
 pub use context::*;
+pub use pipeline_request::PipelineRequest;
 pub use pipeline_store::PipelineStore;

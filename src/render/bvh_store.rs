@@ -89,7 +89,7 @@ pub fn build_in(
     if !bvh.wide.is_empty() {
         let written = cache_file::write_atomically(&path, &cache_file::frame(MAGIC, &encode(&bvh, key, counts)));
         match written {
-            Ok(()) => evict(dir, MAX_BYTES, &path),
+            Ok(()) => cache_file::evict(dir, "bvh", MAX_BYTES, &path),
             Err(e) => eprintln!("warning: BVH store {}: not saved ({e})", path.display()),
         }
     }
@@ -204,28 +204,4 @@ fn check(prim_refs: &[u32], wide: &[GpuWideNode], counts: [u64; 3]) -> Result<()
         }
     }
     Ok(())
-}
-
-/// Removes the least recently written `.bvh` files of `dir` until the rest fit in `max_bytes`, `keep` last.
-pub fn evict(dir: &Path, max_bytes: u64, keep: &Path) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    let mut files: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
-        .filter_map(Result::ok)
-        .filter(|e| e.path().extension().is_some_and(|x| x == "bvh"))
-        .filter_map(|e| {
-            let m = e.metadata().ok()?;
-            Some((m.modified().ok()?, m.len(), e.path()))
-        })
-        .collect();
-    let mut total: u64 = files.iter().map(|f| f.1).sum();
-    // Oldest first; the file just written last of all.
-    files.sort_by_key(|f| (f.2 == keep, f.0));
-    for (_, len, path) in files {
-        if total <= max_bytes {
-            break;
-        }
-        if std::fs::remove_file(&path).is_ok() {
-            total -= len;
-        }
-    }
 }

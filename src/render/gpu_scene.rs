@@ -159,7 +159,12 @@ impl GpuScene {
 
     /// The bindings of group 0 for this layout.
     pub fn bindings(&self) -> Vec<&'static bindings::Binding> {
-        match self.layout {
+        Self::bindings_of(self.layout)
+    }
+
+    /// The bindings of group 0 for `layout`.
+    pub fn bindings_of(layout: SceneLayout) -> Vec<&'static bindings::Binding> {
+        match layout {
             SceneLayout::Separate => bindings::SCENE.iter().map(|b| &b.binding).collect(),
             SceneLayout::Packed => vec![&packed_scene::PACKED],
         }
@@ -167,7 +172,12 @@ impl GpuScene {
 
     /// Group 0's bind-group layout entries.
     pub fn layout_entries(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
-        self.bindings().into_iter().map(bindings::layout_entry).collect()
+        Self::layout_entries_of(self.layout)
+    }
+
+    /// Group 0's bind-group layout entries for `layout`.
+    pub fn layout_entries_of(layout: SceneLayout) -> Vec<wgpu::BindGroupLayoutEntry> {
+        Self::bindings_of(layout).into_iter().map(bindings::layout_entry).collect()
     }
 
     /// Group 0's bind-group entries: the buffers at their bindings.

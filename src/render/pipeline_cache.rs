@@ -20,6 +20,11 @@ impl PipelineCache {
         PipelineCache { map: HashMap::new(), device: memo.clone() }
     }
 
+    /// The device's memo this cache shares through.
+    pub fn memo(&self) -> &PipelineMemo {
+        &self.device
+    }
+
     /// The pipeline for `key`, if built.
     pub fn get(&self, key: &PipelineKey) -> Option<&wgpu::ComputePipeline> {
         self.map.get(key)

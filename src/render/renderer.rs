@@ -4,7 +4,6 @@
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::types::*;
 use crate::gpu::{GpuContext, GpuError};
-use crate::render::bindings;
 use crate::render::env_guide;
 pub use crate::render::error::{InvalidSettings, RenderError};
 use crate::render::features::{Features, PipelineKey};
@@ -13,6 +12,7 @@ use crate::render::gpu_scene::GpuScene;
 use crate::render::packed_scene::{for_layout, SceneLayout};
 use crate::render::pipeline_cache::PipelineCache;
 use crate::render::render_module::{render_source, render_source_for};
+use crate::render::render_pipeline::{bind_group_layouts, pipeline_layout, pipeline_request, RENDER_ENTRY};
 pub use crate::render::settings::RR_DEPTH;
 use crate::render::settings::{Mode, Settings};
 use crate::render::shaders;
@@ -150,20 +150,8 @@ impl Renderer {
     ) -> Result<Renderer, RenderError> {
         settings.validate().map_err(RenderError::Settings)?;
         let device = ctx.device.clone();
-        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene"),
-            entries: &scene.layout_entries(),
-        });
-        let frame_entries: Vec<_> = bindings::FRAME.iter().map(bindings::layout_entry).collect();
-        let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &frame_entries,
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("render"),
-            bind_group_layouts: &[Some(&layout0), Some(&layout1)],
-            immediate_size: 0,
-        });
+        let [layout0, layout1] = bind_group_layouts(&device, scene.layout);
+        let pipeline_layout = pipeline_layout(&device, [&layout0, &layout1]);
         let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout0,
@@ -333,22 +321,30 @@ impl Renderer {
         }
     }
 
-    /// Builds (or finds in this renderer's cache, then in the device's) the pipeline for the current settings.
+    /// Builds (or finds in this renderer's cache, then in the device's) the pipeline for the current settings. A
+    /// pipeline built ahead from an equal request (`render::pipeline_forecast`) is taken instead of building one.
     pub fn prepare(&mut self) -> Result<(), RenderError> {
         let key = self.key();
         let (device, layout) = (&self.device, &self.pipeline_layout);
         let source = if key.features.baked != 0 { &self.source } else { &self.shared_source };
+        let memo = self.pipelines.memo().clone();
         self.pipelines
             .get_or_share(key, source, |store| {
-                shaders::compute_pipeline(
-                    device,
-                    store,
-                    "render",
-                    source,
-                    "render_main",
-                    &key.constants(),
-                    Some(layout),
-                )
+                let request = pipeline_request(source, &key);
+                let pipeline = match memo.take_offer(&request) {
+                    Some(p) => p,
+                    None => shaders::compute_pipeline(
+                        device,
+                        store,
+                        "render",
+                        source,
+                        RENDER_ENTRY,
+                        &key.constants(),
+                        Some(layout),
+                    )?,
+                };
+                memo.note_request(request);
+                Ok(pipeline)
             })
             .map_err(RenderError::Pipeline)
     }
