@@ -378,6 +378,9 @@ struct Opening {
 
 impl Opening {
     fn start(command: String) -> Opening {
+        // The driver's environment variables are set here, before a second thread exists (`set_var` must not race
+        // with another thread's `getenv`).
+        mislab::gpu::prepare_driver_environment();
         let cancel = Arc::new(AtomicBool::new(false));
         let skip = cancel.clone();
         let thread = std::thread::spawn(move || {
