@@ -254,7 +254,7 @@ fn render(args: RenderArgs) -> Result<u8, Failure> {
             );
             if lab.forecasts_taken() > 0 {
                 eprintln!(
-                    "note: the render pipeline was built while the scene loaded (the last run of this command's)"
+                    "note: the render pipeline was built while the scene loaded (as this command's last run used)"
                 );
             }
         },
