@@ -7,7 +7,10 @@
 //! - `consecutive`: a uniform chain whose lanes read eight neighbouring entries (lanes over a node's children);
 //! - `alu`: the per-lane chain's arithmetic with the loads replaced by a hash (the loop's own cost);
 //! - `per_lane_u64`: `per_lane` reading 32 bytes a load (vec4<u64>, on a device with 64-bit integers) from the same
-//!   table: what shaders/geometry_loads_int64.wgsl turns on (a load's cost is per lane, not per byte).
+//!   table: what shaders/geometry_loads_int64.wgsl turns on (a load's cost is per lane, not per byte);
+//! - `per_lane_x4`, `uniform_x4`, `subgroup_x4`: four independent chains a lane (the loads' throughput, not one
+//!   chain's latency), per lane, per workgroup, and per SIMD group through `subgroupBroadcastFirst` (an address the
+//!   driver's divergence analysis can know to be the same in every lane: what a packet traversal would fetch).
 //! `cargo run --release --example load_cost [LOG2_ENTRIES]` prints ns per load per lane for each, best of three dispatches.
 
 use mislab::gpu::GpuContext;
@@ -80,6 +83,41 @@ fn alu(@builtin(global_invocation_id) g: vec3<u32>) {
 }
 "#;
 
+/// Four independent chains per lane (throughput rather than one chain's latency), 16 × STEPS loads in all: per lane, the
+/// same in every lane of a workgroup, and per SIMD group (`subgroupBroadcastFirst`, which the driver's divergence
+/// analysis can see is the same in every lane of the group).
+const KERNELS_X4: &str = r#"
+fn chains_x4(a0: u32, b0: u32, c0: u32, d0: u32) -> u32 {
+    var a = a0; var b = b0; var c = c0; var d = d0;
+    var acc = 0u;
+    for (var i = 0u; i < STEPS * 4u; i++) {
+        let va = table[a & MASK];
+        let vb = table[b & MASK];
+        let vc = table[c & MASK];
+        let vd = table[d & MASK];
+        acc += va.y + vb.z + vc.w + vd.y;
+        a = va.x ^ i; b = vb.x ^ i; c = vc.x ^ i; d = vd.x ^ i;
+    }
+    return acc;
+}
+
+@compute @workgroup_size(64)
+fn per_lane_x4(@builtin(global_invocation_id) g: vec3<u32>) {
+    out[g.x] = chains_x4(hash(g.x), hash(g.x ^ 0x55555555u), hash(g.x + 0x1234567u), hash(g.x * 3u));
+}
+
+@compute @workgroup_size(64)
+fn uniform_x4(@builtin(workgroup_id) w: vec3<u32>, @builtin(global_invocation_id) g: vec3<u32>) {
+    out[g.x] = chains_x4(hash(w.x), hash(w.x ^ 0x55555555u), hash(w.x + 0x1234567u), hash(w.x * 3u)) + g.x;
+}
+
+@compute @workgroup_size(64)
+fn subgroup_x4(@builtin(global_invocation_id) g: vec3<u32>) {
+    let s = subgroupBroadcastFirst(g.x);
+    out[g.x] = chains_x4(hash(s), hash(s ^ 0x55555555u), hash(s + 0x1234567u), hash(s * 3u)) + g.x;
+}
+"#;
+
 /// `per_lane` over the same bytes as 32-byte elements (the u64 halves folded back to words), after KERNELS' header
 /// with the table declared `array<vec4<u64>>` (`u64_source`).
 const KERNEL_U64: &str = r#"
@@ -120,14 +158,20 @@ fn main() {
     }
     let header = &KERNELS[..KERNELS.find("@compute").expect("KERNELS has entry points")];
     let u64_source = header.replace("array<vec4<u32>>", "array<vec4<u64>>") + KERNEL_U64;
-    let entries = ["per_lane", "uniform", "consecutive", "alu", "per_lane_u64"];
-    for entry in entries.into_iter().filter(|e| int64 || *e != "per_lane_u64") {
-        let loads = if entry == "consecutive" { 2.0 } else { 1.0 } * STEPS as f64;
+    let x4_source = header.to_string() + KERNELS_X4;
+    let subgroups = ctx.device.features().contains(wgpu::Features::SUBGROUP);
+    let entries = ["per_lane", "uniform", "consecutive", "alu", "per_lane_u64", "per_lane_x4", "uniform_x4", "subgroup_x4"];
+    for entry in entries.into_iter().filter(|e| (int64 || *e != "per_lane_u64") && (subgroups || *e != "subgroup_x4")) {
+        let loads = if entry == "consecutive" { 2.0 } else if entry.ends_with("_x4") { 16.0 } else { 1.0 } * STEPS as f64;
         let mut best = f64::MAX;
         for _ in 0..3 {
             let t0 = std::time::Instant::now();
             let job = ProbeJob {
-                source: if entry == "per_lane_u64" { &u64_source } else { KERNELS },
+                source: match entry {
+                    "per_lane_u64" => &u64_source,
+                    e if e.ends_with("_x4") => &x4_source,
+                    _ => KERNELS,
+                },
                 entry,
                 inputs: &[table],
                 output_bytes: 4 * lanes as u64,
