@@ -160,9 +160,16 @@ fn main() {
     let u64_source = header.replace("array<vec4<u32>>", "array<vec4<u64>>") + KERNEL_U64;
     let x4_source = header.to_string() + KERNELS_X4;
     let subgroups = ctx.device.features().contains(wgpu::Features::SUBGROUP);
-    let entries = ["per_lane", "uniform", "consecutive", "alu", "per_lane_u64", "per_lane_x4", "uniform_x4", "subgroup_x4"];
+    let entries =
+        ["per_lane", "uniform", "consecutive", "alu", "per_lane_u64", "per_lane_x4", "uniform_x4", "subgroup_x4"];
     for entry in entries.into_iter().filter(|e| (int64 || *e != "per_lane_u64") && (subgroups || *e != "subgroup_x4")) {
-        let loads = if entry == "consecutive" { 2.0 } else if entry.ends_with("_x4") { 16.0 } else { 1.0 } * STEPS as f64;
+        let loads = if entry == "consecutive" {
+            2.0
+        } else if entry.ends_with("_x4") {
+            16.0
+        } else {
+            1.0
+        } * STEPS as f64;
         let mut best = f64::MAX;
         for _ in 0..3 {
             let t0 = std::time::Instant::now();
