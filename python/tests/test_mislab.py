@@ -78,12 +78,18 @@ def test_missing_and_bad_scene_files(tmp_path):
 def test_interrupt_returns_the_partial_image_within_a_second(veach):
     settings = dict(mode="path", max_depth=8, strategy="mis", **SIZE)
     mislab.render(veach, spp=1, **settings)  # compiles the pipeline: the render below starts at once
+    # Python's own Ctrl-C handler, as in a terminal or a notebook: a process started in the background inherits
+    # SIGINT ignored, and Python then installs none, so the signal would never reach the render.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(1.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     t0 = time.monotonic()
-    timer.start()
-    img = mislab.render(veach, time=60, **settings)
-    elapsed = time.monotonic() - t0
-    timer.cancel()
+    try:
+        timer.start()
+        img = mislab.render(veach, time=60, **settings)
+        elapsed = time.monotonic() - t0
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert img.interrupted and img.spp >= 1
     assert elapsed < 1.5 + 1.0, f"the render stopped {elapsed - 1.5:.2f} s after the interrupt"
     assert (img.count >= img.spp).all() and np.isfinite(img.mean).all()
