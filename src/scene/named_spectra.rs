@@ -17,6 +17,8 @@
 use glam::Vec3;
 
 /// (name as in `metal-<name>-eta`, RGB η, RGB k).
+// Measured optical constants; gold's 0.3926 is not π/8 (clippy's approx_constant).
+#[allow(clippy::approx_constant)]
 pub const NAMED_SPECTRA: &[(&str, [f32; 3], [f32; 3])] = &[
     ("Ag", [0.1288, 0.1231, 0.1522], [3.9987, 3.2990, 2.3606]),
     ("Al", [1.3692, 0.9326, 0.5728], [7.6438, 6.6205, 5.3188]),
