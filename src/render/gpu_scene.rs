@@ -170,11 +170,6 @@ impl GpuScene {
         }
     }
 
-    /// Group 0's bind-group layout entries.
-    pub fn layout_entries(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
-        Self::layout_entries_of(self.layout)
-    }
-
     /// Group 0's bind-group layout entries for `layout`.
     pub fn layout_entries_of(layout: SceneLayout) -> Vec<wgpu::BindGroupLayoutEntry> {
         Self::bindings_of(layout).into_iter().map(bindings::layout_entry).collect()
