@@ -20,9 +20,15 @@ struct ShadingCtx {
 fn shading_ctx(x: Surface, m: Material, d: vec3<f32>, id: SampleId, bounce: u32) -> ShadingCtx {
     var c: ShadingCtx;
     c.x = x;
-    c.frame = frame_from_normal(x.ns);
-    c.wo = to_local(c.frame, -d);
     c.brdf = material_bsdf(m, x.uv, x.front);
+    // Seen from behind its shading normal (the geometric normal faces the viewer, the interpolated one does not),
+    // an opaque surface is shaded as its back side: in the frame of −ns, as pbrt-v4's two-sided BxDFs and
+    // Mitsuba 3's `twosided` do, so that such pixels (creases, silhouettes of smooth-shaded meshes) converge to
+    // what their references show. A transmitting BSDF keeps the geometric normal: its inside is the geometric
+    // back (docs/materials.md, "Which side is inside").
+    if (dot(x.ns, -d) < 0.0) { c.x.ns = select(-x.ns, x.ng, bsdf_transmits(c.brdf)); }
+    c.frame = frame_from_normal(c.x.ns);
+    c.wo = to_local(c.frame, -d);
     c.id = id;
     c.bounce = bounce;
     return c;

@@ -84,8 +84,9 @@ fn surface_at(hit: Hit, o: vec3<f32>, d: vec3<f32>) -> Surface {
     let flip = select(-1.0, 1.0, s.front);
     s.ng = ng * flip;
     s.ns = ns * flip;
-    // Keep the shading normal on the viewer's side of the geometric one.
-    if (dot(s.ns, -d) <= 0.0) { s.ns = s.ng; }
+    // A shading normal the ray grazes exactly gives no frame to shade in: the geometric one does. One that faces
+    // away from the viewer is kept; shading_ctx decides with the BSDF.
+    if (!(dot(s.ns, -d) != 0.0)) { s.ns = s.ng; }
     return s;
 }
 
