@@ -2,9 +2,11 @@
 //! hand-made malformed files. Expected counts come from parsing the JSON independently (serde_json `Value`s
 //! via `gltf::json`, never the loader's code path) or from the files' READMEs.
 
+mod scratch;
 use glam::{Vec2, Vec3};
 use gltf::json::Value;
 use mislab::scene::{self, load, LoadOptions, Material, Mesh, PunctualLight, Scene, Texture, Wrap};
+use scratch::Scratch;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
@@ -64,11 +66,8 @@ fn files_under(dir: &str) -> Vec<PathBuf> {
 }
 
 /// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mislab-gltf-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("gltf", name)
 }
 
 /// Loads through `scene::load` and directly, asserting the loader itself never panics (scene::load would

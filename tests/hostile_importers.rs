@@ -5,20 +5,19 @@
 //! Most cases call `mislab::scene::load` (an import never needs the device); `cli_*` tests run the binary for the
 //! exit code. Every case writes its files into a fresh folder of its own under the system's temp directory.
 
+mod scratch;
 use mislab::scene::{load, LoadOptions, Scene};
-use std::path::{Path, PathBuf};
+use scratch::Scratch;
+use std::path::Path;
 use std::process::Command;
 
 /// A fresh folder for one case.
-fn case_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mislab-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn case_dir(name: &str) -> Scratch {
+    Scratch::new("hostile", name)
 }
 
 /// Writes `files` (name, content) into a fresh folder and loads the first one.
-fn load_files(case: &str, files: &[(&str, &[u8])], allow_outside: bool) -> (PathBuf, Result<Scene, String>) {
+fn load_files(case: &str, files: &[(&str, &[u8])], allow_outside: bool) -> (Scratch, Result<Scene, String>) {
     let dir = case_dir(case);
     for (name, content) in files {
         let p = dir.join(name);

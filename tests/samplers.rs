@@ -4,6 +4,7 @@
 //! and measured RMSE convergence slopes on smooth analytic pixel integrands; and one render per sampler.
 
 mod common;
+mod scratch;
 use common::*;
 use mislab::render::samplers::{self, *};
 use mislab::render::settings::{SamplerKind, Settings};
@@ -11,6 +12,7 @@ use mislab::render::shaders;
 use mislab::testkit::chi2;
 use mislab::testkit::metrics::loglog_slope;
 use mislab::testkit::probe::{Probe, ProbeJob};
+use scratch::Scratch;
 
 // ---------------------------------------------------------------------------------------------------------------
 // CPU: tables, constants, spp rules.
@@ -623,11 +625,8 @@ fn samplers_fit_lavapipes_loop_budget() {
 // ---------------------------------------------------------------------------------------------------------------
 // The figure, references and the benchmark, end to end (small).
 
-fn scratch(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("mislab-samplers-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("samplers", name)
 }
 
 /// The figure is written in both formats, and its spectra tell blue noise from white noise: at 1 spp the
@@ -839,7 +838,8 @@ fn bench_from_toml() {
 #[ignore]
 fn lecture_suite_end_to_end() {
     use clap::Parser;
-    let out = std::env::var("MISLAB_SUITE_OUT").unwrap_or_else(|_| scratch("suite").to_string_lossy().into_owned());
+    let suite_dir = scratch("suite");
+    let out = std::env::var("MISLAB_SUITE_OUT").unwrap_or_else(|_| suite_dir.to_string_lossy().into_owned());
     let extra = std::env::var("MISLAB_BENCH_ARGS").unwrap_or_else(|_| "--suite lecture".into());
     let args: Vec<String> = ["bench".to_string()]
         .into_iter()

@@ -1,8 +1,10 @@
 //! Scene tests: built-in scenes against their READMEs, the TOML format and its errors, and environment-map loading.
 
+mod scratch;
 use glam::{Vec3, Vec4Swizzles};
 use mislab::scene::envmap::{direction_to_equirect, equirect_direction, load_envmap};
 use mislab::scene::{self, builtin, Environment, LoadOptions, Material, PunctualLight, Quad, Scene};
+use scratch::Scratch;
 use std::path::{Path, PathBuf};
 
 const TESTDATA_ENV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/testdata/env");
@@ -29,11 +31,8 @@ fn quad_center(q: &Quad) -> Vec3 {
 }
 
 /// A scratch directory unique to this test process and `name`.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mislab-scenes-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("scenes", name)
 }
 
 // ---------------------------------------------------------------------------------------------------------------
