@@ -249,10 +249,14 @@ fn env_from_texels(name: &str, w: u32, h: u32, texels: &[[f32; 3]]) -> Result<(E
     std::fs::create_dir_all(&dir).map_err(|e| LabError::Input(format!("{}: {e}", dir.display())))?;
     let path = dir.join(format!("{name}.exr"));
     let img = image::Rgb32FImage::from_fn(w, h, |x, y| image::Rgb(texels[(y * w + x) as usize]));
-    img.save_with_format(&path, image::ImageFormat::OpenExr)
-        .map_err(|e| LabError::Input(format!("{}: {e}", path.display())))?;
-    let (map, warnings) = scene::envmap::load_envmap(&path).map_err(LabError::from)?;
+    let loaded = img
+        .save_with_format(&path, image::ImageFormat::OpenExr)
+        .map_err(|e| LabError::Input(format!("{}: {e}", path.display())))
+        .and_then(|()| scene::envmap::load_envmap(&path).map_err(LabError::from));
+    // Nothing is left behind, whether or not it loaded (the folder goes once it is empty).
     let _ = std::fs::remove_file(&path);
+    let _ = std::fs::remove_dir(&dir);
+    let (map, warnings) = loaded?;
     Ok((Environment::Map { map: Arc::new(map), scale: 1.0, rotation: 0.0 }, warnings))
 }
 
