@@ -5,7 +5,7 @@ perf sees no symbols in the code LLVM generates at run time, only addresses. Thi
 `mislab render`), samples it with `perf record` once shader compilation is over, disassembles the hot code from
 the live process with gdb, and sorts the samples by what lavapipe made of the shader's memory accesses: Mesa
 22's lavapipe runs every storage-buffer or workgroup-memory access whose address differs between lanes as a loop
-over the SIMD lanes (`cmp $0x8, counter` closes it), one loop per load or store instruction, with a bounds check
+over the SIMD lanes (`cmp $0x4, counter` closes it with mislab's 4-lane code, $0x8 with 8 lanes), one loop per load or store instruction, with a bounds check
 per component for storage buffers. Storage loads are told apart by the descriptor slot they read their base
 pointer from (an offset into lavapipe's context; on Mesa 22.3.6 slot 0x7f00 + 16·b is binding b of the render
 pipeline's layout, e.g. 0x7f20 the triangle vertices, 0x7fe0 the wide BVH nodes). Mesa 25 unrolls these loops into a
@@ -68,11 +68,12 @@ def disassemble(pid, hot):
 
 
 def lane_loops(ins):
-    """(first, end) address ranges of lavapipe's per-lane loops: `xor r, r` … `cmp $0x8, r; jae end`."""
+    """(first, end) address ranges of lavapipe's per-lane loops: `xor r, r` … `cmp $LANES, r; jae end`, LANES 4
+    (mislab's default 128-bit code, docs/platform-notes.md), 8 or 16."""
     addrs = sorted(ins)
     loops = []
     for i, a in enumerate(addrs[:-1]):
-        m = re.match(r"cmp\s+\$0x8,(%e\w\w|%r\d+d)$", ins[a])
+        m = re.match(r"cmp\s+\$0x(?:4|8|10),(%e\w\w|%r\d+d)$", ins[a])
         j = re.search(r"jae\s+0x([0-9a-f]+)", ins[addrs[i + 1]])
         if not (m and j):
             continue
@@ -92,7 +93,7 @@ def classify(ins, hot, loops):
         text = " ".join(ins[b] for b in body) + " "
         pct = sum(hot.get(b, 0.0) for b in body)
         slots = sorted(set(re.findall(r"mov\s+(0x[0-9a-f]+)\(%r\w+\),%r\w+\s", text)))
-        loads = len(re.findall(r"vpbroadcastd\s+\(%r", text))
+        loads = len(re.findall(r"vpbroadcast[dq]\s+\(%r", text))
         stores = len(re.findall(r"mov\s+%\w+,\(%r\w+,%r\w+,[14]\)", text))
         if slots:
             kind = f"storage load, slot {','.join(slots)}, {loads} components"
