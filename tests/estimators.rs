@@ -13,7 +13,7 @@ use mislab::render::settings::*;
 use mislab::render::Renderer;
 use mislab::render::{gpu_scene::GpuScene, scene_data::SceneData};
 use mislab::scene::builtin::{VEACH_LIGHTS, VEACH_PLATES};
-use mislab::scene::{Camera, Material, Quad, Scene, Sphere};
+use mislab::scene::{Camera, Environment, Material, Mesh, Quad, Scene, Sphere};
 use std::sync::{Mutex, OnceLock};
 
 /// Family-wise level of every test in this file.
@@ -1395,7 +1395,7 @@ fn tilted_normal_sheet(n: u32, from_behind: bool) -> Scene {
     let eye = Vec3::new(side * dist * elevation.cos(), dist * elevation.sin(), 0.0);
     s.camera = Camera::look_at(eye, Vec3::ZERO, Vec3::Y, 20.0);
     s.materials.push(Material::lambert("sheet", Vec3::splat(SHEET_RHO as f32)));
-    s.environment = mislab::scene::Environment::Constant(Vec3::ONE);
+    s.environment = Environment::Constant(Vec3::ONE);
     let tilt = SHEET_TILT_DEG.to_radians() as f32;
     let ns = Vec3::new(tilt.sin(), tilt.cos(), 0.0);
     let at = |i: u32| -1.0 + 2.0 * i as f32 / n as f32;
@@ -1406,7 +1406,7 @@ fn tilted_normal_sheet(n: u32, from_behind: bool) -> Scene {
         .flat_map(|(i, j)| [[v(i, j), v(i, j + 1), v(i + 1, j + 1)], [v(i, j), v(i + 1, j + 1), v(i + 1, j)]])
         .collect();
     let normals = vec![ns; positions.len()];
-    s.meshes.push(mislab::scene::Mesh { name: "sheet".into(), positions, normals, uvs: vec![], indices, material: 0 });
+    s.meshes.push(Mesh { name: "sheet".into(), positions, normals, uvs: vec![], indices, material: 0 });
     s
 }
 
@@ -1426,8 +1426,8 @@ fn a_surface_seen_from_behind_its_shading_normal_reflects_as_its_back_side() {
         for from_behind in [true, false] {
             let sc = tilted_normal_sheet(n, from_behind);
             let value = SHEET_RHO * if from_behind { 1.0 - cos_t } else { 1.0 + cos_t } / 2.0;
-            // Pixels whose whole footprint lies on the sheet.
-            let z_plane = |o: DVec3, d: DVec3| -> Option<DVec3> {
+            // Pixels whose whole footprint lies on the sheet (the plane y = 0 within |x|, |z| < 1).
+            let sheet_hit = |o: DVec3, d: DVec3| -> Option<DVec3> {
                 let t = -o.y / d.y;
                 let p = o + t * d;
                 (t > 0.0 && p.x.abs() < 1.0 && p.z.abs() < 1.0).then_some(p)
@@ -1440,7 +1440,7 @@ fn a_surface_seen_from_behind_its_shading_normal_reflects_as_its_back_side() {
                         .iter()
                         .all(|&(fx, fy)| {
                             let (o, d) = camera_ray(&sc.camera, w, h, px + fx, py + fy);
-                            z_plane(o, d).is_some()
+                            sheet_hit(o, d).is_some()
                         })
                         .then_some(value)
                 })
