@@ -5,23 +5,18 @@
 //! and BSDF rays (the floor gets half the analytic irradiance of the square light).
 
 mod common;
+mod scratch;
 
 use mislab::render::features::Features;
 use mislab::render::scene_data::SceneData;
 use mislab::render::settings::{Mode, Settings, Strategy};
 use mislab::scene::{self, LoadOptions, Scene};
 use std::f64::consts::PI;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mislab-alpha-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// 256² checkerboard of 4-pixel cells (64 × 64 cells): alpha 0 (a hole) or 255, RGB white.
-fn write_mask() -> PathBuf {
-    let path = dir().join("checker.png");
+/// 256² checkerboard of 4-pixel cells (64 × 64 cells): alpha 0 (a hole) or 255, RGB white, in `dir`.
+fn write_mask(dir: &Path) -> PathBuf {
+    let path = dir.join("checker.png");
     let img = image::RgbaImage::from_fn(256, 256, |x, y| {
         let a = if (x / 4 + y / 4) % 2 == 0 { 255 } else { 0 };
         image::Rgba([255, 255, 255, a])
@@ -34,7 +29,8 @@ fn write_mask() -> PathBuf {
 /// (half-side 1, radiance 1) at y = 1 facing down, a Lambert 0.5 floor at y = 0; the camera at y = 0.25 looks up
 /// (at the light through the mask, 60°) or down (at the floor, 1°).
 fn load(camera_up: bool, masked: bool) -> Scene {
-    write_mask(); // beside the scene file, named relative to it (scene files may not reach outside their folder)
+    let dir = scratch::unique("alpha");
+    write_mask(&dir); // beside the scene file, named relative to it (scene files may not reach outside their folder)
     let look = if camera_up {
         "LookAt 0 0.25 0  0 1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 60 ]"
     } else {
@@ -62,7 +58,7 @@ AttributeBegin
 AttributeEnd
 "#
     );
-    let path = dir().join(format!("alpha-{camera_up}-{masked}.pbrt"));
+    let path = dir.join(format!("alpha-{camera_up}-{masked}.pbrt"));
     std::fs::write(&path, text).unwrap();
     let s = scene::load(path.to_str().unwrap(), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert!(s.warnings.iter().all(|w| !w.contains("alpha")), "alpha is imported: {:?}", s.warnings);

@@ -1,6 +1,8 @@
 //! The embeddable API (`mislab::api`): one loop for every budget, observers that watch and stop, a render in steps
 //! equal to one render, and flags named once for every front end.
 
+mod scratch;
+
 use mislab::api::{self, Budget, Job, Lab, Observer, Progress, RenderFlags, SceneHandle};
 
 fn lab() -> Lab {
@@ -35,8 +37,7 @@ fn flags_parse_like_the_command_line_and_name_what_is_wrong() {
 fn a_missing_scene_is_not_found_and_a_bad_one_a_scene_error() {
     let e = SceneHandle::named("no-such-dir/none.gltf").err().unwrap();
     assert!(matches!(e, api::ApiError::NotFound(_)), "{e}");
-    let dir = std::env::temp_dir().join(format!("mislab-api-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::Scratch::new("api", "bad-scene");
     let bad = dir.join("bad.pbrt");
     std::fs::write(&bad, "WorldBegin\nFrobnicate 1\n").unwrap();
     let e = SceneHandle::named(bad.to_str().unwrap()).err().unwrap();
@@ -154,8 +155,7 @@ fn a_scene_files_render_settings_are_the_defaults_and_flags_override_them() {
     assert!(j.resolve(&veach).is_empty());
     assert_eq!((j.settings.mode, j.budget), (Mode::Direct, Budget::Samples(api::DEFAULT_SPP)));
     // A file's sampler is taken only where it can render the sample count: stratified has a maximum (2^20).
-    let dir = std::env::temp_dir().join(format!("mislab-api-sampler-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::Scratch::new("api", "file-sampler");
     let scene_with = |sampler: &str| {
         let path = dir.join("s.pbrt");
         let text = format!("{sampler}\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nShape \"sphere\"\n");

@@ -3,6 +3,9 @@
 //! a missing adapter is exit code 2 with instructions, and Ctrl-C still writes the image.
 
 mod common;
+mod scratch;
+
+use scratch::Scratch;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -34,10 +37,9 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mislab-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// This test's scratch folder (removed when it passes).
+fn tmp(test: &str) -> Scratch {
+    Scratch::new("cli", test)
 }
 
 fn shared(rel: &str) -> PathBuf {
@@ -46,10 +48,11 @@ fn shared(rel: &str) -> PathBuf {
 
 #[test]
 fn every_builtin_renders_without_nan() {
+    let dir = tmp("builtins");
     for (scene, mode) in
         [("veach-mis", "direct"), ("cornell-box", "path"), ("furnace", "path"), ("area-vs-cosine", "direct")]
     {
-        let out = tmp(&format!("{scene}.png"));
+        let out = dir.join(format!("{scene}.png"));
         let mut c = mislab();
         c.args(["render", scene, "--spp", "4", "--width", "64", "--height", "64", "--mode", mode, "-o"]).arg(&out);
         let o = run(c, Duration::from_secs(180));
@@ -63,7 +66,8 @@ fn every_builtin_renders_without_nan() {
 
 #[test]
 fn exr_output_is_linear_float() {
-    let out = tmp("furnace.exr");
+    let dir = tmp("exr");
+    let out = dir.join("furnace.exr");
     let mut c = mislab();
     c.args(["render", "furnace", "--spp", "16", "--width", "16", "--height", "16", "-o"]).arg(&out);
     let o = run(c, Duration::from_secs(120));
@@ -74,8 +78,8 @@ fn exr_output_is_linear_float() {
 }
 
 /// Expects exit code 2, a message naming `name`, and no output image.
-fn assert_clean_failure(args: &[&str], scene: &Path, name_in_message: &str) {
-    let out = tmp(&format!("fail-{}.png", name_in_message.replace(['/', ' '], "_")));
+fn assert_clean_failure(dir: &Path, args: &[&str], scene: &Path, name_in_message: &str) {
+    let out = dir.join(format!("fail-{}.png", name_in_message.replace(['/', ' '], "_")));
     let _ = std::fs::remove_file(&out);
     let mut c = mislab();
     c.arg("render").arg(scene).args(args).args(["--spp", "1", "--width", "8", "--height", "8", "-o"]).arg(&out);
@@ -95,22 +99,28 @@ fn assert_clean_failure(args: &[&str], scene: &Path, name_in_message: &str) {
 
 #[test]
 fn bad_scenes_fail_cleanly() {
-    assert_clean_failure(&[], Path::new("no/such/scene.gltf"), "no/such/scene.gltf");
-    assert_clean_failure(&[], &shared("testdata/gltf/khronos/Box/glTF-Draco/Box.gltf"), "KHR_draco_mesh_compression");
+    let dir = tmp("bad-scenes");
+    assert_clean_failure(&dir, &[], Path::new("no/such/scene.gltf"), "no/such/scene.gltf");
+    assert_clean_failure(
+        &dir,
+        &[],
+        &shared("testdata/gltf/khronos/Box/glTF-Draco/Box.gltf"),
+        "KHR_draco_mesh_compression",
+    );
     // A truncated .glb.
     let full = std::fs::read(shared("testdata/gltf/khronos/Box/glTF-Binary/Box.glb")).unwrap();
-    let cut = tmp("truncated.glb");
+    let cut = dir.join("truncated.glb");
     std::fs::write(&cut, &full[..full.len() / 2]).unwrap();
-    assert_clean_failure(&[], &cut, "truncated.glb");
+    assert_clean_failure(&dir, &[], &cut, "truncated.glb");
     // Garbage and a wrong extension.
-    let junk = tmp("junk.glb");
+    let junk = dir.join("junk.glb");
     std::fs::write(&junk, b"this is not a glb at all").unwrap();
-    assert_clean_failure(&[], &junk, "junk.glb");
-    let toml = tmp("bad.toml");
+    assert_clean_failure(&dir, &[], &junk, "junk.glb");
+    let toml = dir.join("bad.toml");
     std::fs::write(&toml, "[camera\nposition = 1").unwrap();
-    assert_clean_failure(&[], &toml, "bad.toml");
+    assert_clean_failure(&dir, &[], &toml, "bad.toml");
     // A missing environment map.
-    assert_clean_failure(&["--env", "missing.hdr"], Path::new("furnace"), "missing.hdr");
+    assert_clean_failure(&dir, &["--env", "missing.hdr"], Path::new("furnace"), "missing.hdr");
 }
 
 /// Every file in the shared robustness corpus: a clean error (exit 2) or a render with a warning.
@@ -130,8 +140,9 @@ fn robustness_corpus_never_panics() {
         }
     }
     assert!(files.len() >= 10, "the corpus should have at least 10 files");
+    let dir = tmp("robustness");
     for f in files {
-        let out = tmp("robust.png");
+        let out = dir.join("robust.png");
         let _ = std::fs::remove_file(&out);
         let mut c = mislab();
         c.arg("render").arg(&f).args(["--spp", "1", "--width", "8", "--height", "8", "-o"]).arg(&out);
@@ -152,8 +163,9 @@ fn robustness_corpus_never_panics() {
 
 #[test]
 fn unknown_adapter_is_exit_2_with_instructions() {
+    let dir = tmp("no-adapter");
     let mut c = mislab();
-    c.env("WGPU_ADAPTER_NAME", "no-such-adapter-xyz").args(["render", "--spp", "1", "-o"]).arg(tmp("never.png"));
+    c.env("WGPU_ADAPTER_NAME", "no-such-adapter-xyz").args(["render", "--spp", "1", "-o"]).arg(dir.join("never.png"));
     let o = run(c, Duration::from_secs(60));
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("no-such-adapter-xyz"));
@@ -167,7 +179,8 @@ fn unknown_adapter_is_exit_2_with_instructions() {
 
 #[test]
 fn interrupt_writes_what_has_accumulated() {
-    let out = tmp("interrupted.png");
+    let dir = tmp("interrupt");
+    let out = dir.join("interrupted.png");
     let _ = std::fs::remove_file(&out);
     let mut c = mislab();
     c.args(["render", "cornell-box", "--mode", "path", "--time", "120", "--width", "64", "--height", "64", "-o"])
@@ -205,10 +218,10 @@ fn forecasts(cache: &Path) -> Vec<PathBuf> {
 #[test]
 fn a_repeated_render_takes_its_forecast_pipeline_and_no_other() {
     const TAKEN: &str = "note: the render pipeline was built while the scene loaded";
-    let cache = tmp("forecast-cache");
-    let _ = std::fs::remove_dir_all(&cache);
+    let dir = tmp("forecast");
+    let cache = dir.join("cache");
     let render = |scene: &str, out: &str| {
-        let out = tmp(out);
+        let out = dir.join(out);
         let mut c = mislab();
         c.env("XDG_CACHE_HOME", &cache);
         c.args(["render", scene, "--spp", "2", "--width", "16", "--height", "16", "-o"]).arg(&out);
@@ -243,5 +256,4 @@ fn a_repeated_render_takes_its_forecast_pipeline_and_no_other() {
     assert_eq!(damaged, furnace);
     let (err, _) = render("furnace", "fc-a4.exr");
     assert!(err.contains(TAKEN), "the damaged forecast was rewritten:\n{err}");
-    let _ = std::fs::remove_dir_all(&cache);
 }

@@ -3,6 +3,7 @@
 //! pixels of the uncropped one.
 
 mod common;
+mod scratch;
 
 use mislab::render::settings::{Mode, Settings};
 use mislab::scene::{self, Camera, LoadOptions, Scene};
@@ -10,12 +11,21 @@ use mislab::scene::{self, Camera, LoadOptions, Scene};
 const W: u32 = 64;
 const H: u32 = 48;
 
-fn write(name: &str, text: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("mislab-film-crop-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A scene file written into a scratch folder of its own, removed with it.
+struct Written(#[allow(dead_code)] scratch::Scratch, std::path::PathBuf);
+
+impl std::ops::Deref for Written {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        &self.1
+    }
+}
+
+fn write(name: &str, text: &str) -> Written {
+    let dir = scratch::unique("film-crop");
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    path
+    Written(dir, path)
 }
 
 fn load(path: &std::path::Path) -> Scene {

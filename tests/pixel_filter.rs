@@ -4,6 +4,7 @@
 //! the radius pbrt-v4 gives it and one more; the filter comes from the scene file's `PixelFilter`.
 
 mod common;
+mod scratch;
 
 use mislab::render::pixel_filter;
 use mislab::render::settings::{Mode, PixelFilter, Settings};
@@ -16,8 +17,7 @@ const SPP: u32 = 1024;
 /// An emitter over x > 0 at z = 1 (radiance 1, two-sided), seen from the origin along +z, with `filter`'s
 /// PixelFilter statement.
 fn load(filter: &str) -> Scene {
-    let dir = std::env::temp_dir().join(format!("mislab-pixel-filter-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::unique("pixel-filter");
     let path = dir.join(format!("edge-{}.pbrt", filter.replace(|c: char| !c.is_ascii_alphanumeric(), "_")));
     let text = format!(
         r#"LookAt 0 0 0  0 0 1  0 1 0

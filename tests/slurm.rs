@@ -25,6 +25,10 @@ impl Drop for Cluster {
             let _ = c.kill();
             let _ = c.wait();
         }
+        // The daemons' logs and the parts stay where a failing test can be looked into.
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.dir);
+        }
     }
 }
 

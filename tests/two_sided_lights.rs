@@ -4,6 +4,7 @@
 //! sampling and MIS. The light table counts both faces' power.
 
 mod common;
+mod scratch;
 
 use mislab::render::scene_data::SceneData;
 use mislab::render::settings::{LightSampling, Mode, Settings, Strategy};
@@ -41,8 +42,7 @@ AttributeEnd
 }
 
 fn load(two_sided: bool, up: bool) -> Scene {
-    let dir = std::env::temp_dir().join(format!("mislab-two-sided-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::unique("two-sided");
     let path = dir.join(format!("light-{two_sided}-{up}.pbrt"));
     std::fs::write(&path, scene_text(two_sided, up)).unwrap();
     let s = scene::load(path.to_str().unwrap(), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));

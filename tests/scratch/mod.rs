@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// `mislab-<prefix>-<pid>-<name>` under the system's temp folder, emptied on creation, removed on drop unless
 /// the thread is panicking (a failing test's files stay).
@@ -15,6 +16,13 @@ impl Scratch {
         std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
         Scratch(dir)
     }
+}
+
+/// A scratch folder of its own for each call (numbered), for a helper that tests running at the same time call
+/// with the same arguments.
+pub fn unique(prefix: &str) -> Scratch {
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    Scratch::new(prefix, &NEXT.fetch_add(1, Ordering::Relaxed).to_string())
 }
 
 impl std::ops::Deref for Scratch {
