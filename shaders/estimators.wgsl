@@ -50,11 +50,14 @@ fn env_receiver(n: vec3<f32>, transmits: bool) -> vec3<f32> {
     return select(n, vec3<f32>(0.0), transmits);
 }
 
-/// Whether world direction w (local wi) leaves c on a side its BSDF does not allow: a reflection must leave
-/// above the geometric surface and a transmission below it (a shading normal must not leak light through).
+/// Whether world direction w (local wi) leaves c on a side its BSDF does not allow. Where the BSDF transmits, the
+/// geometric surface decides: a reflection leaves above it and a transmission below it (a shading normal must not
+/// turn one into the other). An opaque BSDF is judged in its shading frame alone, as pbrt-v4's BxDFs and Mitsuba 3's
+/// are: a reflection may leave below the geometric surface where the shading normal leans past it, and its ray then
+/// starts on that side (`spawn_origin`). A closed mesh blocks such rays itself; an open one lets the sky in there,
+/// as both references do (docs/materials.md, "A shading normal that faces away from the viewer").
 fn wrong_side(c: ShadingCtx, w: vec3<f32>, wi: vec3<f32>) -> bool {
-    if (bsdf_transmits(c.brdf)) { return (dot(w, c.x.ng) > 0.0) != (wi.z > 0.0) || wi.z == 0.0; }
-    return dot(w, c.x.ng) <= 0.0;
+    return bsdf_transmits(c.brdf) && ((dot(w, c.x.ng) > 0.0) != (wi.z > 0.0) || wi.z == 0.0);
 }
 
 /// pdf (solid angle) of the direction technique producing local direction wi.

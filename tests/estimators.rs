@@ -1388,7 +1388,9 @@ const SHEET_TILT_DEG: f64 = 60.0;
 /// A flat Lambert sheet y = 0, |x|, |z| ≤ 1, front +Y, of n × n cells (2n² triangles: n = 1 is baked, n = 8 goes
 /// through the BVH), whose vertex normals all lean SHEET_TILT_DEG towards +X, under a constant sky of radiance 1.
 /// The camera looks down at it at 20° from the −X side (behind the shading normal: n_s·v < 0 < n_g·v) or the +X side.
-fn tilted_normal_sheet(n: u32, from_behind: bool) -> Scene {
+/// With `backed`, a black plate (ρ = 0) lies just below the sheet and far beyond it, hidden from the camera by the
+/// sheet: it blocks the sky below the sheet's plane.
+fn tilted_normal_sheet(n: u32, from_behind: bool, backed: bool) -> Scene {
     let mut s = Scene { name: "tilted-normal sheet".into(), ..Default::default() };
     let side = if from_behind { -1.0 } else { 1.0 };
     let (elevation, dist) = (20f32.to_radians(), 4.0);
@@ -1407,54 +1409,83 @@ fn tilted_normal_sheet(n: u32, from_behind: bool) -> Scene {
         .collect();
     let normals = vec![ns; positions.len()];
     s.meshes.push(Mesh { name: "sheet".into(), positions, normals, uvs: vec![], indices, material: 0 });
+    if backed {
+        // 1e-3 below the sheet and 1e4 across: a ray from the sheet that passes beside it leaves within 1e-7 rad
+        // of the plane, a share of the cosine-weighted sky far below the test's noise.
+        let (y, r) = (-1e-3, 1e4);
+        s.materials.push(Material::lambert("black", Vec3::ZERO));
+        let positions = vec![Vec3::new(-r, y, -r), Vec3::new(r, y, -r), Vec3::new(r, y, r), Vec3::new(-r, y, r)];
+        let indices = vec![[0, 2, 1], [0, 3, 2]];
+        s.meshes.push(Mesh { name: "plate".into(), positions, normals: vec![], uvs: vec![], indices, material: 1 });
+    }
     s
 }
 
-/// A surface seen from behind its shading normal is shaded as its back side, in the frame of −n_s (pbrt-v4's
-/// two-sided BxDFs and Mitsuba 3's `twosided` do the same; estimators.wgsl `shading_ctx`), and a reflection still
-/// leaves above the geometric surface only (`wrong_side`). Under a constant sky L the sheet then reflects
-/// ρ·L·(1 − cos t)/2 towards a viewer behind n_s and ρ·L·(1 + cos t)/2 towards one in front of it — the sky's
-/// cosine-weighted share about the normal in use, cut by the geometric plane at angle t (π − t behind). Replacing
-/// n_s by n_g, as mislab did before, gives ρ·L to both, 4× too bright behind: the dark creases of smooth-shaded
-/// meshes that Mitsuba's references show came out lit. Per-pixel z-tests against those exact values, baked and
-/// through the BVH, direct light by MIS.
+/// A surface seen from behind its shading normal is shaded as its back side, in the frame of −n_s, and an opaque
+/// BSDF is judged in its shading frame alone: a reflection may leave below the geometric plane (pbrt-v4's BxDFs and
+/// Mitsuba 3's `twosided` do both; estimators.wgsl `shading_ctx`, `wrong_side`). Under a constant sky L:
+/// - with the sky below the sheet blocked (`backed`), the sheet reflects ρ·L·(1 − cos t)/2 towards a viewer behind
+///   n_s and ρ·L·(1 + cos t)/2 towards one in front of it: the sky's cosine-weighted share about the normal in use,
+///   cut by the plate's plane at angle t (π − t behind). Replacing n_s by n_g, as mislab did before 2026-12-08,
+///   gives ρ·L to both: the dark creases of smooth-shaded meshes that Mitsuba's references show came out lit;
+/// - alone, it reflects ρ·L to both: the normal in use sees the whole sky, part of it through the sheet's plane.
+///   Refusing reflections below the geometric plane, as mislab did until later that day, gives the values above:
+///   darker than both references wherever a mesh is open behind such a face (a grey Khronos VC: relMSE at 256 spp
+///   2.3e-4 against Mitsuba's reference, 5.0e-5 without the refusal).
+///
+/// Per-pixel z-tests against those exact values, baked and through the BVH, direct light by MIS.
 #[test]
 fn a_surface_seen_from_behind_its_shading_normal_reflects_as_its_back_side() {
     let (w, h) = (32, 32);
     let cos_t = SHEET_TILT_DEG.to_radians().cos();
-    for n in [1, 8] {
-        for from_behind in [true, false] {
-            let sc = tilted_normal_sheet(n, from_behind);
-            let value = SHEET_RHO * if from_behind { 1.0 - cos_t } else { 1.0 + cos_t } / 2.0;
-            // Pixels whose whole footprint lies on the sheet (the plane y = 0 within |x|, |z| < 1).
-            let sheet_hit = |o: DVec3, d: DVec3| -> Option<DVec3> {
-                let t = -o.y / d.y;
-                let p = o + t * d;
-                (t > 0.0 && p.x.abs() < 1.0 && p.z.abs() < 1.0).then_some(p)
-            };
-            let expected: Vec<Option<f64>> = (0..w * h)
-                .map(|i| {
-                    let (px, py) = ((i % w) as f64, (i / w) as f64);
-                    let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
-                    corners
-                        .iter()
-                        .all(|&(fx, fy)| {
-                            let (o, d) = camera_ray(&sc.camera, w, h, px + fx, py + fy);
-                            sheet_hit(o, d).is_some()
-                        })
-                        .then_some(value)
-                })
-                .collect();
-            let (exact, mask) = exact_film(&expected, w, h);
-            let on_sheet = mask.iter().filter(|&&m| m).count();
-            assert!(on_sheet >= 200, "{n}×{n} sheet: only {on_sheet} pixels see the sheet");
-            let mut bench = Bench::new(&sc, w, h);
-            let film = bench.render(&cfg(Strategy::Mis).apply(&small(w, h)), 1024);
-            let what = format!(
-                "{n}×{n} sheet seen from {} its shading normal, expected {value:.4}",
-                if from_behind { "behind" } else { "in front of" }
-            );
+    for (n, from_behind, backed) in (0..8).map(|k| ([1, 8][k & 1], k & 2 != 0, k & 4 != 0)) {
+        let sc = tilted_normal_sheet(n, from_behind, backed);
+        let share = if !backed {
+            1.0
+        } else if from_behind {
+            (1.0 - cos_t) / 2.0
+        } else {
+            (1.0 + cos_t) / 2.0
+        };
+        let value = SHEET_RHO * share;
+        // Pixels whose whole footprint lies on the sheet (the plane y = 0 within |x|, |z| < 1).
+        let sheet_hit = |o: DVec3, d: DVec3| -> Option<DVec3> {
+            let t = -o.y / d.y;
+            let p = o + t * d;
+            (t > 0.0 && p.x.abs() < 1.0 && p.z.abs() < 1.0).then_some(p)
+        };
+        let expected: Vec<Option<f64>> = (0..w * h)
+            .map(|i| {
+                let (px, py) = ((i % w) as f64, (i / w) as f64);
+                let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+                corners
+                    .iter()
+                    .all(|&(fx, fy)| {
+                        let (o, d) = camera_ray(&sc.camera, w, h, px + fx, py + fy);
+                        sheet_hit(o, d).is_some()
+                    })
+                    .then_some(value)
+            })
+            .collect();
+        let (exact, mask) = exact_film(&expected, w, h);
+        let on_sheet = mask.iter().filter(|&&m| m).count();
+        assert!(on_sheet >= 200, "{n}×{n} sheet: only {on_sheet} pixels see the sheet");
+        let mut bench = Bench::new(&sc, w, h);
+        let film = bench.render(&cfg(Strategy::Mis).apply(&small(w, h)), 1024);
+        let what = format!(
+            "{n}×{n} sheet{} seen from {} its shading normal, expected {value:.4}",
+            if backed { " on a black plate" } else { "" },
+            if from_behind { "behind" } else { "in front of" }
+        );
+        if backed {
             assert_agrees(&what, &compare(&film, &exact, Some(&mask)), w);
+        } else {
+            // Nothing blocks the sky, so every light and BSDF sample weighs ρ·L exactly (f·L·cos / pdf with the
+            // cosine's pdf): a z-test has no variance to divide by. Each pixel must be ρ·L to rounding.
+            for i in (0..mask.len()).filter(|&i| mask[i]) {
+                let got = film.mean[i].map(|v| v as f64);
+                assert!(got.iter().all(|v| (v - value).abs() < 1e-5), "{what}: pixel {i} is {got:?}");
+            }
         }
     }
 }
