@@ -8,8 +8,9 @@ does not know and calls it. Nothing it writes is committed: two of the models st
 
   scripts/held-out-scenes.py --models DIR --out /tmp/heldout
 
-DIR holds the Khronos glTF-Binary files 2CylinderEngine.glb, ReciprocatingSaw.glb, BrainStem.glb and VC.glb, e.g.
-from `git show HEAD:2.0/NAME/glTF-Binary/NAME.glb` in a clone of github:sbtron/glTF-Sample-Models (54e8526).
+DIR holds the Khronos glTF-Binary files 2CylinderEngine.glb, ReciprocatingSaw.glb, BrainStem.glb, VC.glb and
+CesiumMilkTruck.glb (`git show HEAD:2.0/NAME/glTF-Binary/NAME.glb` in a clone of github:sbtron/glTF-Sample-Models,
+54e8526), and the glTF files with their .bin of Suzanne, Lantern and Corset (`2.0/NAME/glTF/`).
 material-testball comes from ../shared/testdata. A missing source is skipped with a message. Needs numpy.
 """
 import argparse
@@ -39,7 +40,11 @@ scenes = {
     # Faces seen from their geometric back with normals leaning away: docs/materials.md, "A shading normal that
     # faces away from the viewer".
     "vc": {"src": os.path.join(a.models, "VC.glb"), "origin": khronos % "VC", "camera": dict(orbit, elevation=35.0)},
+    "milktruck": {"src": os.path.join(a.models, "CesiumMilkTruck.glb"), "origin": khronos % "CesiumMilkTruck",
+                  "camera": orbit},
 }
+for name, file in (("suzanne", "Suzanne"), ("lantern", "Lantern"), ("corset", "Corset")):
+    scenes[name] = {"src": os.path.join(a.models, file + ".gltf"), "origin": khronos % file, "camera": orbit}
 testball = m.bitterli("material-testball", "Material Testball", "Wig42", "blendswap", [640, 360])
 testball["src"] = os.path.join(SHARED, "testdata", "scenes", "bitterli", "material-testball", "pbrt-v4",
                                "scene-v4.pbrt")
