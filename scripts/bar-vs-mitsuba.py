@@ -12,12 +12,10 @@ channels, as src/testkit/metrics.rs computes it.
   scripts/bar-vs-mitsuba.py ../shared/bench-scenes/damagedhelmet_grey --width 256 --height 256
 """
 import argparse
-import os
 import pathlib
 import re
 import subprocess
 import sys
-import time
 
 p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 p.add_argument("scene_dir", help="a bench-scene folder holding <stem>.xml and <stem>.toml")
@@ -31,47 +29,20 @@ p.add_argument("--mitsuba-sampler", default="multijitter", help="Mitsuba's sampl
 p.add_argument("--mislab-args", default="", help="extra mislab render arguments (an A/B of a setting), e.g. '--env-sampling importance'")
 a = p.parse_args()
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
-import drjit as dr  # noqa: E402
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import mitsuba_bar as mb  # noqa: E402
 import mitsuba as mi  # noqa: E402
 import numpy as np  # noqa: E402
 
-mi.set_variant("llvm_ad_rgb")
-dr.set_thread_count(a.threads)
+mb.setup(a.threads)
 d = pathlib.Path(a.scene_dir)
 stem = d.name
 xml, toml = d / f"{stem}.xml", d / f"{stem}.toml"
 cache = pathlib.Path(a.cache)
 cache.mkdir(parents=True, exist_ok=True)
-
-
-def relmse(x, r):
-    return float(np.mean((x - r) ** 2 / (r * r + 0.01)))
-
-
-scene = mi.load_file(str(xml), width=a.width, height=a.height, max_depth=8, spp=16)
-# The same scene with another sampler: the file's text with its sampler's type replaced, its paths resolved from
-# the scene's folder.
-mi.file_resolver().prepend(str(d))
-text = xml.read_text().replace('<sampler type="independent">', f'<sampler type="{a.mitsuba_sampler}">')
-scene_best = mi.load_string(text, width=a.width, height=a.height, max_depth=8, spp=16)
-ref_path = cache / f"{stem}-{a.width}x{a.height}-{a.ref_spp}spp.npy"
-if ref_path.exists():
-    ref = np.load(ref_path)
-else:
-    acc, done, k = None, 0, 0
-    while done < a.ref_spp:
-        n = min(64, a.ref_spp - done)
-        img = np.array(mi.render(scene, spp=n, seed=1000 + k), dtype=np.float64)[:, :, :3]
-        acc = img * n if acc is None else acc + img * n
-        done, k = done + n, k + 1
-    ref = acc / done
-    np.save(ref_path, ref)
-
-np.array(mi.render(scene_best, spp=16, seed=7))  # warm-up: the JIT compiles the kernel
-t0 = time.perf_counter()
-m16 = np.array(mi.render(scene_best, spp=16, seed=11), dtype=np.float64)[:, :, :3]
-T = time.perf_counter() - t0
+relmse = mb.relmse
+ref = mb.reference(xml, a.width, a.height, cache, a.ref_spp)
+m16, T = mb.best_16spp(xml, a.width, a.height, a.mitsuba_sampler)
 E = relmse(m16, ref)
 rows = [(f"Mitsuba 3.9.1 llvm_ad_rgb, {a.mitsuba_sampler}, 16 spp", T, 16, E)]
 

@@ -28,7 +28,7 @@ import os
 import pathlib
 import shutil
 import subprocess
-import time
+import sys
 
 # The bar's scenes and sizes (docs/performance.md, "Time to Mitsuba's error").
 SCENES = {
@@ -50,53 +50,25 @@ p.add_argument("--threads", type=int, default=2)
 p.add_argument("--no-loader", action="store_true", help="skip downloading the Vulkan loader packages")
 a = p.parse_args()
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
-import drjit as dr  # noqa: E402
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
+import mitsuba_bar as mb  # noqa: E402
 import mitsuba as mi  # noqa: E402
 import numpy as np  # noqa: E402
 
-mi.set_variant("llvm_ad_rgb")
-dr.set_thread_count(a.threads)
+mb.setup(a.threads)
 out = pathlib.Path(a.out)
 (out / "refs").mkdir(parents=True, exist_ok=True)
 (out / "scenes").mkdir(exist_ok=True)
-
-
-def relmse(x, r):
-    return float(np.mean((x - r) ** 2 / (r * r + 0.01)))
-
-
-def reference(xml, stem, w, h):
-    """The bar's reference: Mitsuba, independent sampler, 1024 spp in 64-spp runs seeded 1000 + k."""
-    path = pathlib.Path(a.cache) / f"{stem}-{w}x{h}-1024spp.npy"
-    if path.exists():
-        return np.load(path)
-    scene = mi.load_file(str(xml), width=w, height=h, max_depth=8, spp=16)
-    acc = None
-    for k in range(16):
-        img = np.array(mi.render(scene, spp=64, seed=1000 + k), dtype=np.float64)[:, :, :3]
-        acc = img * 64 if acc is None else acc + img * 64
-    ref = acc / 1024
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.save(path, ref)
-    return ref
-
 
 table = {}
 for stem, (w, h) in SCENES.items():
     d = pathlib.Path(a.bench) / stem
     xml = d / f"{stem}.xml"
-    ref = reference(xml, stem, w, h)
+    ref = mb.reference(xml, w, h, a.cache)
     mi.Bitmap(ref.astype(np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB).write(str(out / "refs" / f"{stem}.exr"))
-    # Mitsuba at its most efficient sampler, as the bar measures it: a warm-up, then 16 spp timed.
-    mi.file_resolver().prepend(str(d))
-    text = xml.read_text().replace('<sampler type="independent">', '<sampler type="multijitter">')
-    scene = mi.load_string(text, width=w, height=h, max_depth=8, spp=16)
-    np.array(mi.render(scene, spp=16, seed=7))
-    t0 = time.perf_counter()
-    m16 = np.array(mi.render(scene, spp=16, seed=11), dtype=np.float64)[:, :, :3]
-    T = time.perf_counter() - t0
-    table[stem] = {"width": w, "height": h, "T": T, "E": relmse(m16, ref)}
+    # Mitsuba at its most efficient sampler, as the bar measures it.
+    m16, T = mb.best_16spp(xml, w, h)
+    table[stem] = {"width": w, "height": h, "T": T, "E": mb.relmse(m16, ref)}
     dst = out / "scenes" / stem
     dst.mkdir(exist_ok=True)
     for ext in ("toml", "glb"):
